@@ -1,0 +1,44 @@
+# Bounce GI — two commands for a fresh machine: `make demo` and `make test`.
+SHELL := /bin/bash
+PYENV_ROOT ?= $(shell pyenv root 2>/dev/null || echo $$HOME/.pyenv)
+# Python 3.13 found by path (bpy 5.2 needs exactly 3.13); the bare python3.13 shim refuses without PYENV_VERSION.
+PY313 ?= $(firstword $(wildcard $(PYENV_ROOT)/versions/3.13*/bin/python3.13) $(shell command -v python3.13 2>/dev/null))
+VENV := .venv
+PY := $(VENV)/bin/python
+# System libraries bpy needs even headless, and Mesa's EGL + llvmpipe for moderngl without a GPU.
+APT_PACKAGES := libx11-6 libxi6 libxfixes3 libxrender1 libxkbcommon0 libsm6 libice6 libxext6 libgl1 \
+                libegl1 libegl-mesa0 libgl1-mesa-dri
+STAMP := $(VENV)/.setup-done
+
+.PHONY: setup demo test package clean system-libs
+
+setup: $(STAMP)
+
+$(STAMP): requirements.txt pyproject.toml
+	@$(MAKE) --no-print-directory system-libs
+	@if [ -z "$(PY313)" ]; then echo "error: Python 3.13 not found under $(PYENV_ROOT)/versions (bpy 5.2 needs it)"; exit 2; fi
+	@test -x $(PY) || $(PY313) -m venv $(VENV)
+	$(PY) -m pip install -q --upgrade pip
+	$(PY) -m pip install -q -r requirements.txt
+	$(PY) -m pip install -q --no-deps -e .
+	@touch $(STAMP)
+
+system-libs:
+	@missing=""; for p in $(APT_PACKAGES); do dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
+	if [ -n "$$missing" ]; then \
+	  echo "installing system libraries:$$missing"; \
+	  SUDO=""; [ "$$(id -u)" = 0 ] || SUDO=sudo; \
+	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq $$missing >/dev/null; \
+	fi
+
+demo: setup
+	$(VENV)/bin/bounce-gi demo --out out/demo
+
+test: setup
+	$(PY) -m pytest -q
+
+package: setup
+	$(PY) tools/package.py
+
+clean:
+	rm -rf out dist build *.egg-info

@@ -1,0 +1,172 @@
+"""Cycles ground truth: two-seed reference renders with the settings of design.md §3, cached by content hash.
+
+Settings: CPU, adaptive sampling off, denoising off, clamps 0, light threshold 0, pixel filter 0.01 px (so Cycles
+samples pixel centres like our rasteriser), fixed bounce counts. The mean of the two seeds is the reference; half
+the rel-L1 between the seeds is the reference's own noise floor, reported beside every error.
+The user's scene is restored after rendering (every touched setting is put back), so nothing is changed in the .blend.
+"""
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+import time
+from contextlib import contextmanager
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..gpu_kernels import exr_io, metrics
+
+PASS_FLAGS = ("use_pass_diffuse_direct", "use_pass_diffuse_indirect", "use_pass_diffuse_color", "use_pass_emit",
+              "use_pass_normal", "use_pass_z", "use_pass_position", "use_pass_glossy_direct",
+              "use_pass_glossy_indirect", "use_pass_glossy_color")
+COMPARED_PASSES = ("Combined", "Diffuse Direct", "Diffuse Indirect", "Diffuse Color")
+
+
+@dataclass(frozen=True)
+class ReferenceSettings:
+    width: int
+    height: int
+    samples: int = 256
+    seeds: tuple = (1, 2)
+    bounces: int = 8  # diffuse (and total) bounces; 1 = one indirect bounce; fixed so results are comparable
+
+
+@dataclass
+class Reference:
+    passes: dict  # mean of the seeds
+    seeds: list  # per-seed passes
+    seconds: float  # Cycles render time (sum over seeds) when rendered now; the cached value otherwise
+    cached: bool
+
+    def noise_floor(self, name: str, mask=None) -> float:
+        """Half the rel-L1 between the two seeds: the error the reference itself carries."""
+        a, b = self.seeds[0][name], self.seeds[1][name]
+        return 0.5 * metrics.rel_l1(a, b, mask)
+
+
+def cache_dir() -> Path:
+    root = os.environ.get("BOUNCE_GI_CACHE") or os.path.join(os.path.expanduser("~"), ".cache", "bounce-gi")
+    return Path(root) / "references"
+
+
+def cache_key(scene_hash: str, settings: ReferenceSettings) -> str:
+    import hashlib
+
+    import bpy
+
+    text = json.dumps([scene_hash, asdict(settings), bpy.app.version_string], sort_keys=True, default=str)
+    return hashlib.sha1(text.encode()).hexdigest()[:20]
+
+
+@contextmanager
+def _saved(objects_attrs):
+    """Remember (object, attribute) values and put them back afterwards."""
+    saved = []
+    for obj, attr in objects_attrs:
+        try:
+            saved.append((obj, attr, getattr(obj, attr)))
+        except AttributeError:
+            pass
+    try:
+        yield
+    finally:
+        for obj, attr, value in reversed(saved):
+            try:
+                setattr(obj, attr, value)
+            except (AttributeError, TypeError):
+                pass
+
+
+def _configure(scene, view_layer, settings: ReferenceSettings, seed: int, path: str) -> None:
+    c, r = scene.cycles, scene.render
+    r.engine = "CYCLES"
+    c.device = "CPU"
+    c.samples = settings.samples
+    c.use_adaptive_sampling = False
+    c.use_denoising = False
+    c.sample_clamp_direct = 0.0
+    c.sample_clamp_indirect = 0.0  # defaults to 10: turn it off (design.md §3)
+    c.light_sampling_threshold = 0.0
+    c.filter_width = 0.01
+    c.seed = seed
+    c.use_animated_seed = False
+    b = settings.bounces
+    c.max_bounces = b
+    c.diffuse_bounces = b
+    c.glossy_bounces = b
+    c.transmission_bounces = b
+    c.volume_bounces = 0
+    c.transparent_max_bounces = 8
+    c.caustics_reflective = True
+    c.caustics_refractive = True
+    r.resolution_x, r.resolution_y, r.resolution_percentage = settings.width, settings.height, 100
+    r.use_border = False
+    r.film_transparent = False
+    for flag in PASS_FLAGS:
+        if hasattr(view_layer, flag):
+            setattr(view_layer, flag, True)
+    im = r.image_settings
+    if hasattr(im, "media_type"):
+        im.media_type = "MULTI_LAYER_IMAGE"
+    im.file_format = "OPEN_EXR_MULTILAYER"
+    im.color_depth = "32"
+    r.filepath = path
+
+
+def _settings_to_save(scene, view_layer):
+    c, r = scene.cycles, scene.render
+    attrs = [(r, a) for a in ("engine", "resolution_x", "resolution_y", "resolution_percentage", "use_border",
+                              "film_transparent", "filepath")]
+    attrs += [(c, a) for a in ("device", "samples", "use_adaptive_sampling", "use_denoising", "sample_clamp_direct",
+                               "sample_clamp_indirect", "light_sampling_threshold", "filter_width", "seed",
+                               "use_animated_seed", "max_bounces", "diffuse_bounces", "glossy_bounces",
+                               "transmission_bounces", "volume_bounces", "transparent_max_bounces",
+                               "caustics_reflective", "caustics_refractive")]
+    attrs += [(view_layer, f) for f in PASS_FLAGS]
+    im = r.image_settings
+    attrs += [(im, "color_depth"), (im, "file_format")] + ([(im, "media_type")] if hasattr(im, "media_type") else [])
+    return attrs
+
+
+def render_reference(scene_hash: str, settings: ReferenceSettings, progress=None) -> Reference:
+    """Render (or load from cache) the two-seed Cycles reference of the current bpy scene."""
+    import bpy
+
+    directory = cache_dir()
+    key = cache_key(scene_hash, settings)
+    meta_path = directory / f"{key}.json"
+    seed_paths = [directory / f"{key}_seed{s}.exr" for s in settings.seeds]
+    if meta_path.exists() and all(p.exists() for p in seed_paths):
+        try:
+            seeds = [exr_io.read_passes(str(p)) for p in seed_paths]
+            seconds = json.loads(meta_path.read_text())["seconds"]
+            return Reference(_mean(seeds), seeds, seconds, cached=True)
+        except (OSError, ValueError, KeyError):
+            pass  # a broken cache entry is simply rendered again
+    directory.mkdir(parents=True, exist_ok=True)
+    scene = bpy.context.scene
+    view_layer = bpy.context.view_layer
+    seeds, seconds = [], 0.0
+    with tempfile.TemporaryDirectory(prefix="bounce-gi-ref-") as tmp, _saved(_settings_to_save(scene, view_layer)):
+        for i, seed in enumerate(settings.seeds):
+            if progress:
+                progress(f"Cycles reference: seed {seed} ({i + 1}/{len(settings.seeds)}), "
+                         f"{settings.samples} samples at {settings.width}x{settings.height}")
+            out = os.path.join(tmp, f"seed{seed}.exr")
+            _configure(scene, view_layer, settings, seed, out)
+            start = time.perf_counter()
+            bpy.ops.render.render(write_still=True)
+            seconds += time.perf_counter() - start
+            passes = exr_io.read_passes(out)
+            seeds.append(passes)
+            exr_io.write_passes(str(seed_paths[i]), passes)
+    meta_path.write_text(json.dumps({"seconds": seconds, "settings": asdict(settings), "scene": scene_hash}))
+    return Reference(_mean(seeds), seeds, seconds, cached=False)
+
+
+def _mean(seeds: list) -> dict:
+    names = set.intersection(*(set(s) for s in seeds))
+    return {n: np.mean([s[n] for s in seeds], axis=0).astype(np.float32) for n in names}

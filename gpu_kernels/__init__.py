@@ -1,0 +1,1 @@
+"""Bounce GI's pure GPU core: Scene in, Cycles-named passes and timings out. Never imports bpy."""

@@ -1,0 +1,43 @@
+"""The process-wide render engine: one GPU worker thread, one pipeline (so caches survive between renders)."""
+from __future__ import annotations
+
+import threading
+from concurrent.futures import Future
+
+from .gpu_context import GpuWorker
+from .pipeline import Pipeline, RenderResult, RenderSettings, check_renderable
+from .scene import Scene
+
+_engine = None
+_lock = threading.Lock()
+
+
+class Engine:
+    def __init__(self, worker: GpuWorker | None = None):
+        self.worker = worker or GpuWorker()
+        self._pipeline: Pipeline | None = None
+
+    def submit_render(self, scene: Scene, settings: RenderSettings) -> Future:
+        """Queue a render on the GPU thread; the Future resolves to a RenderResult (or raises its error)."""
+        check_renderable(scene, settings)  # fail fast, on the caller's thread, for bad input
+        return self.worker.submit(self._render, scene, settings)
+
+    def render(self, scene: Scene, settings: RenderSettings) -> RenderResult:
+        return self.submit_render(scene, settings).result()
+
+    def _render(self, ctx, scene, settings):
+        if self._pipeline is None:
+            self._pipeline = Pipeline(ctx)
+        return self._pipeline.render(scene, settings)
+
+    def gl_info(self) -> dict:
+        return self.worker.call(lambda ctx: {"renderer": ctx.info["GL_RENDERER"], "version": ctx.version_code})
+
+
+def get_engine() -> Engine:
+    """The shared engine (created on first use)."""
+    global _engine
+    with _lock:
+        if _engine is None:
+            _engine = Engine()
+        return _engine

@@ -1,0 +1,146 @@
+"""The render pipeline: a scene and settings in, Cycles-named passes (numpy) and per-pass seconds out.
+
+Passes and their inputs (a pass re-runs only when one of its inputs changed — see pass_cache.py):
+    geometry      ← scene geometry
+    textures      ← materials (images)
+    shadow_maps   ← geometry, materials (emissive triangles), lights, shadow settings
+    gbuffer       ← geometry, materials, camera, resolution
+    direct_light  ← gbuffer, shadow_maps
+    compose       ← everything above, world      (CPU: passes as numpy, Combined)
+"""
+from __future__ import annotations
+
+import hashlib
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+from . import direct
+from .light_buffers import ShadowSettings
+from .pass_cache import PassCache
+from .programs import ProgramCache
+from .scene import Scene, _hash_into
+
+METHODS = ("none", "lpv", "vct")
+PASS_NAMES = ("Combined", "Diffuse Direct", "Diffuse Indirect", "Diffuse Color", "Emission", "Normal", "Position",
+              "Depth")
+BACKGROUND_DEPTH = 1e10  # Cycles writes 1e10 to the Depth pass where no geometry was hit
+
+
+class SceneError(ValueError):
+    """The scene cannot be rendered as given (message is for the user)."""
+
+
+@dataclass(frozen=True)
+class RenderSettings:
+    method: str = "none"
+    width: int = 640
+    height: int = 480
+    shadow: ShadowSettings = field(default_factory=ShadowSettings)
+
+    def key(self) -> str:
+        return repr(sorted(asdict(self).items()))
+
+
+@dataclass
+class RenderResult:
+    passes: dict  # name -> (H, W, C) float32, rows top-to-bottom
+    timings: dict  # pass name -> seconds (0.0 when the pass was skipped), plus "total"
+    skipped: list  # passes whose cached result was still valid
+    warnings: list
+    statistics: dict
+    method: str
+    resolution: tuple
+
+
+def _hash(*parts) -> str:
+    h = hashlib.sha1()
+    for p in parts:
+        _hash_into(h, p)
+    return h.hexdigest()
+
+
+def check_renderable(scene: Scene, settings: RenderSettings) -> None:
+    if settings.method not in METHODS:
+        raise SceneError(f"unknown method '{settings.method}' (choose from {', '.join(METHODS)})")
+    if settings.method != "none":
+        raise NotImplementedError(f"method '{settings.method}' is not implemented yet; use --method none")
+    if scene.camera is None:
+        raise SceneError("the scene has no camera")
+    if settings.width < 1 or settings.height < 1 or settings.width > 16384 or settings.height > 16384:
+        raise SceneError(f"resolution {settings.width}x{settings.height} is out of range (1..16384)")
+
+
+class Pipeline:
+    """Owns the GL resources of one context and re-runs only the passes whose inputs changed."""
+
+    def __init__(self, ctx):
+        self.ctx = ctx
+        self.programs = ProgramCache(ctx)
+        self.cache = PassCache(finish=ctx.finish)
+
+    def render(self, scene: Scene, settings: RenderSettings) -> RenderResult:
+        import time
+
+        check_renderable(scene, settings)
+        start = time.perf_counter()
+        ctx, programs, cache = self.ctx, self.programs, self.cache
+        cache.begin_frame()
+        k_geometry = _hash(scene.positions, scene.normals, scene.uvs, scene.material_index)
+        k_materials = _hash(scene.materials, scene.textures)
+        k_lights = _hash(scene.lights)
+        k_camera = _hash(scene.camera, scene.pixel_aspect, settings.width, settings.height)
+        k_world = _hash(scene.world)
+
+        geometry = cache.run("geometry", (k_geometry,), lambda: direct.upload_geometry(ctx, programs, scene))
+        textures = cache.run("textures", (k_materials,), lambda: direct.upload_textures(ctx, scene))
+        k_shadow = (k_geometry, k_materials, k_lights, repr(settings.shadow))
+        shadows = cache.run("shadow_maps", k_shadow,
+                            lambda: direct.render_shadow_atlas(ctx, programs, scene, geometry, settings.shadow))
+        k_gbuffer = (k_geometry, k_materials, k_camera)
+        gbuffer = cache.run("gbuffer", k_gbuffer, lambda: direct.render_gbuffer(
+            ctx, programs, scene, geometry, textures, settings.width, settings.height))
+        k_direct = (k_gbuffer, k_shadow)
+        direct_tex = cache.run("direct_light", k_direct,
+                               lambda: direct.render_direct_light(ctx, programs, gbuffer, shadows))
+        passes = cache.run("compose", (k_direct, k_world),
+                           lambda: compose_passes(gbuffer, direct_tex, scene.world.color))
+        timings = dict(cache.timings)
+        timings["total"] = time.perf_counter() - start
+        return RenderResult(passes=passes, timings=timings, skipped=list(cache.skipped),
+                            warnings=list(scene.warnings) + list(shadows.warnings),
+                            statistics=scene.statistics(), method=settings.method,
+                            resolution=(settings.width, settings.height))
+
+    def release(self) -> None:
+        self.cache.clear()
+        self.programs.release()
+
+
+def compose_passes(gbuffer, direct_tex, world_color, indirect: np.ndarray | None = None) -> dict:
+    """Read the GPU results back and build the Cycles-named passes; Combined = (direct+indirect)·colour + emission."""
+    position = direct.read_texture(gbuffer.textures["position"])
+    hit = position[..., 3:4] > 0.5
+    normal = direct.read_texture(gbuffer.textures["normal"])
+    albedo = direct.read_texture(gbuffer.textures["albedo"], 3) * hit
+    emission = direct.read_texture(gbuffer.textures["emission"], 3) * hit
+    # Cycles divides its light passes by Diffuse Color per channel and writes 0 where that colour is 0
+    # (safe_divide_even_color), so a surface with no diffuse part shows no diffuse light.
+    has_diffuse = albedo > 0
+    diffuse_direct = direct.read_texture(direct_tex, 3) * has_diffuse
+    diffuse_indirect = np.zeros_like(diffuse_direct) if indirect is None else indirect * has_diffuse
+    combined = np.empty(albedo.shape[:2] + (4,), np.float32)
+    combined[..., :3] = np.where(hit, (diffuse_direct + diffuse_indirect) * albedo + emission,
+                                 np.asarray(world_color, np.float32)[:3])
+    combined[..., 3] = 1.0  # the world is visible to the camera (film not transparent), as in Cycles' default
+    depth = np.where(hit, normal[..., 3:4], BACKGROUND_DEPTH).astype(np.float32)
+    return {
+        "Combined": combined,
+        "Diffuse Direct": diffuse_direct.astype(np.float32),
+        "Diffuse Indirect": diffuse_indirect.astype(np.float32),
+        "Diffuse Color": albedo.astype(np.float32),
+        "Emission": emission.astype(np.float32),
+        "Normal": (normal[..., :3] * hit).astype(np.float32),
+        "Position": (position[..., :3] * hit).astype(np.float32),
+        "Depth": depth,
+    }

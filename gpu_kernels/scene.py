@@ -1,0 +1,162 @@
+"""The GPU side's only input: a scene as plain dataclasses and numpy arrays.
+
+Everything here is in Blender's world space (metres, Z up) and Blender's units (design.md §3).
+`addon/extract.py` builds it from a depsgraph; tests and examples may build it by hand. No bpy.
+"""
+from __future__ import annotations
+
+import hashlib
+from dataclasses import dataclass, field, fields, is_dataclass
+
+import numpy as np
+
+LIGHT_TYPES = ("SUN", "POINT", "SPOT", "AREA")
+AREA_SHAPES = ("SQUARE", "RECTANGLE", "DISK", "ELLIPSE")
+
+
+@dataclass
+class Texture:
+    """An RGB(A) image in scene-linear float, rows bottom-up (OpenGL/Blender order)."""
+    name: str
+    pixels: np.ndarray  # (H, W, 4) float32
+    interpolation: str = "Linear"  # "Linear" | "Closest"
+    extension: str = "REPEAT"  # "REPEAT" | "EXTEND" | "CLIP"
+
+
+@dataclass
+class Material:
+    """What the pipeline understands of a material; extraction reduces node trees to this."""
+    name: str
+    base_color: tuple = (0.8, 0.8, 0.8)  # linear RGB, the diffuse albedo when no texture
+    base_color_texture: int = -1  # index into Scene.textures, or -1
+    emission: tuple = (0.0, 0.0, 0.0)  # emission colour × strength (radiance, W/(m²·sr) per unit)
+    roughness: float = 0.5
+    metallic: float = 0.0
+    specular_layer: bool = False  # Principled: a dielectric GGX layer takes a view-dependent share (see gbuffer.glsl)
+
+
+@dataclass
+class Light:
+    """A Blender light in Cycles' meaning (design.md §3); `color` already includes energy-independent tint."""
+    name: str
+    type: str  # one of LIGHT_TYPES
+    color: tuple  # linear RGB tint (temperature applied), not including power
+    power: float  # W for POINT/SPOT/AREA; irradiance W/m² for SUN (strength)
+    matrix_world: np.ndarray  # (4, 4) float64; the light shines along its local -Z
+    radius: float = 0.0  # point/spot soft size (m)
+    angle: float = 0.0  # sun angular diameter (rad)
+    spot_size: float = np.pi / 4  # full cone angle (rad)
+    spot_blend: float = 0.15
+    shape: str = "SQUARE"  # area shape
+    size: float = 1.0  # area size along local X (m)
+    size_y: float = 1.0  # area size along local Y (m), RECTANGLE/ELLIPSE
+    soft_falloff: bool = True  # Blender 4+: a radius-r point/spot acts as a disk facing the receiver, E ∝ 1/(d²+r²)
+    cast_shadow: bool = True
+
+    @property
+    def position(self) -> np.ndarray:
+        return np.asarray(self.matrix_world, np.float64)[:3, 3].copy()
+
+    @property
+    def direction(self) -> np.ndarray:
+        """Unit vector the light points along (local -Z in world space)."""
+        d = -np.asarray(self.matrix_world, np.float64)[:3, 2]
+        return d / np.linalg.norm(d)
+
+
+@dataclass
+class Camera:
+    """Blender camera data needed to reproduce its projection pixel for pixel."""
+    matrix_world: np.ndarray  # (4, 4) camera-to-world; camera looks along local -Z, +Y up
+    type: str = "PERSP"  # "PERSP" | "ORTHO"
+    lens: float = 50.0  # mm
+    sensor_width: float = 36.0  # mm
+    sensor_height: float = 24.0  # mm
+    sensor_fit: str = "AUTO"  # "AUTO" | "HORIZONTAL" | "VERTICAL"
+    ortho_scale: float = 7.0
+    shift_x: float = 0.0
+    shift_y: float = 0.0
+    clip_start: float = 0.1
+    clip_end: float = 100.0
+
+
+@dataclass
+class World:
+    color: tuple = (0.0, 0.0, 0.0)  # constant background radiance = colour × strength
+
+
+@dataclass
+class Scene:
+    """Triangle soup in world space plus materials, lights, world and camera.
+
+    positions: (T, 3, 3) float32 — triangle corners
+    normals:   (T, 3, 3) float32 — per-corner shading normals as Blender shows them
+    uvs:       (T, 3, 2) float32 — per-corner UVs (zeros when the mesh has none)
+    material_index: (T,) int32 — index into `materials`
+    """
+    positions: np.ndarray
+    normals: np.ndarray
+    uvs: np.ndarray
+    material_index: np.ndarray
+    materials: list = field(default_factory=list)
+    textures: list = field(default_factory=list)
+    lights: list = field(default_factory=list)
+    world: World = field(default_factory=World)
+    camera: Camera | None = None
+    resolution: tuple = (640, 480)  # the scene's render resolution (after percentage)
+    pixel_aspect: tuple = (1.0, 1.0)
+    warnings: list = field(default_factory=list)
+
+    @property
+    def triangle_count(self) -> int:
+        return int(self.positions.shape[0])
+
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """Axis-aligned world bounds of all triangles (min, max)."""
+        if self.triangle_count == 0:
+            return np.zeros(3), np.zeros(3)
+        p = self.positions.reshape(-1, 3)
+        return p.min(axis=0).astype(np.float64), p.max(axis=0).astype(np.float64)
+
+    def has_emission(self) -> bool:
+        used = set(np.unique(self.material_index).tolist()) if self.triangle_count else set()
+        return any(max(self.materials[i].emission) > 0 for i in used if 0 <= i < len(self.materials))
+
+    def statistics(self) -> dict:
+        lo, hi = self.bounds()
+        return {
+            "triangles": self.triangle_count,
+            "materials": len(self.materials),
+            "textures": len(self.textures),
+            "lights": {t: sum(1 for l in self.lights if l.type == t) for t in LIGHT_TYPES},
+            "bounds": [lo.tolist(), hi.tolist()],
+        }
+
+    def content_hash(self) -> str:
+        """A stable hash of everything that affects a render (used to key reference caches)."""
+        h = hashlib.sha256()
+        _hash_into(h, self)
+        return h.hexdigest()[:20]
+
+
+def _hash_into(h, value) -> None:
+    if isinstance(value, np.ndarray):
+        a = np.ascontiguousarray(value)
+        h.update(str((a.dtype.str, a.shape)).encode())
+        h.update(a.tobytes())
+    elif is_dataclass(value):
+        h.update(type(value).__name__.encode())
+        for f in fields(value):
+            if f.name == "warnings":
+                continue
+            h.update(f.name.encode())
+            _hash_into(h, getattr(value, f.name))
+    elif isinstance(value, (list, tuple)):
+        h.update(b"[")
+        for v in value:
+            _hash_into(h, v)
+        h.update(b"]")
+    elif isinstance(value, float):
+        h.update(repr(round(value, 9)).encode())
+    else:
+        h.update(repr(value).encode())

@@ -1,0 +1,226 @@
+"""The preview operator's steps in background Blender: image writing, panel drawing, and a real
+render of a tiny scene (cube + sun + camera) through addon.extract and the gpu_kernels engine.
+
+Modal operators never run in background mode, so the operator's execute() (blocking) and the plain
+functions in ui/preview.py are what is exercised; invoke()/modal() only schedule those same steps.
+Each case runs in its own subprocess (bpy state must not leak) and prints what it sees.
+"""
+import os
+import subprocess
+import sys
+import textwrap
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+# Prepended to every case: `bounce_gi` is this checkout, its UI registered.
+PRELUDE = """
+import sys
+import bpy
+import numpy as np
+import bounce_gi
+from bounce_gi.ui import preview
+bounce_gi.register()
+"""
+
+
+def run_case(tmp_path, body: str, setup: str = "", timeout: float = 180) -> str:
+    pkg = tmp_path / "pkg"
+    pkg.mkdir()
+    os.symlink(ROOT, pkg / "bounce_gi")  # import this checkout whether or not it is pip-installed
+    code = PRELUDE + setup + textwrap.dedent(body) + "\nprint('CASE OK')\n"
+    env = {**os.environ, "PYTHONPATH": str(pkg), "BLENDER_USER_RESOURCES": str(tmp_path / "user")}
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=timeout,
+                          cwd=ROOT, env=env)
+    output = f"--- exit status {proc.returncode}\n--- stdout\n{proc.stdout}\n--- stderr\n{proc.stderr}"
+    assert proc.returncode == 0 and "CASE OK" in proc.stdout, output
+    return proc.stdout
+
+
+def test_write_preview_image_orientation_and_reuse(tmp_path):
+    run_case(tmp_path, """
+        a = np.zeros((3, 5, 4), np.float32)
+        a[0, :, 0] = 2.5          # top row red, above 1: float buffer must keep it
+        a[..., 3] = 1.0
+        img = preview.write_preview_image(a)
+        px = np.empty(5 * 3 * 4, np.float32); img.pixels.foreach_get(px); px = px.reshape(3, 5, 4)
+        print("size", tuple(img.size), "float", img.is_float, "colorspace", img.colorspace_settings.name)
+        assert img.name == "Bounce GI Preview" and tuple(img.size) == (5, 3) and img.is_float
+        assert img.colorspace_settings.name != "sRGB"
+        assert np.allclose(px[2, :, 0], 2.5) and np.allclose(px[0, :, 0], 0.0), px[..., 0]  # Blender: bottom-up
+
+        # A new size reuses the same datablock; RGB input gets alpha 1.
+        img2 = preview.write_preview_image(np.full((2, 4, 3), 0.25, np.float32))
+        px = np.empty(4 * 2 * 4, np.float32); img2.pixels.foreach_get(px)
+        print("resized", tuple(img2.size), "images", [i.name for i in bpy.data.images])
+        assert img2 == img and tuple(img2.size) == (4, 2) and np.allclose(px.reshape(-1, 4), [0.25, 0.25, 0.25, 1])
+
+        # A byte image (sRGB) of the same name is kept aside, never overwritten.
+        img.name = "other"
+        bpy.data.images.new("Bounce GI Preview", 2, 2)
+        img3 = preview.write_preview_image(np.ones((2, 2, 4), np.float32))
+        print("images", sorted(i.name for i in bpy.data.images))
+        assert img3.is_float and "Bounce GI Preview (old)" in bpy.data.images
+
+        try:
+            preview.write_preview_image(np.ones((4, 4), np.float32))
+        except preview.PreviewError as ex:
+            print("bad shape:", ex)
+        else:
+            raise AssertionError("a 2-D Combined pass was accepted")
+    """)
+
+
+def test_panels_draw_with_valid_names(tmp_path):
+    # No UI in background mode, so draw() gets a recording layout that checks every property,
+    # operator and icon name against Blender's RNA (typos there only show up as console errors).
+    run_case(tmp_path, """
+        from types import SimpleNamespace
+        from bounce_gi.ui import panel
+        icons = set(bpy.types.UILayout.bl_rna.functions["label"].parameters["icon"].enum_items.keys())
+        seen = []
+
+        class Layout:
+            def __getattr__(self, name):   # row(), column(), box(), split() ...
+                return lambda *a, **k: Layout()
+            def __setattr__(self, name, value):
+                pass
+            def prop(self, data, name, **k):
+                assert name in data.bl_rna.properties, name; seen.append(("prop", name))
+            def operator(self, idname, **k):
+                mod, op = idname.split(".")
+                getattr(getattr(bpy.ops, mod), op).get_rna_type(); seen.append(("op", idname))
+                assert k.get("icon", "NONE") in icons, k
+            def label(self, text="", icon="NONE", **k):
+                assert icon in icons, icon; seen.append(("label", text))
+
+        ctx = SimpleNamespace(scene=bpy.context.scene)
+        preview.state.last = preview.RenderReport("none", 32, 24, {"gbuffer": 0.002, "shadow_maps": 0.0,
+                                                  "total": 0.01}, ["material 'X' fell back"], 0.5, ["shadow_maps"])
+        preview.state.last_error = "an error"
+        for busy in (False, True):
+            preview.state.busy = busy
+            panel.VIEW3D_PT_bounce_gi.draw(SimpleNamespace(layout=Layout()), ctx)
+        assert panel.VIEW3D_PT_bounce_gi_last_render.poll(ctx)
+        panel.VIEW3D_PT_bounce_gi_last_render.draw(SimpleNamespace(layout=Layout()), ctx)
+        print(seen)
+        assert ("label", "cached") in seen and ("label", "material 'X' fell back") in seen
+        assert {("prop", "method"), ("prop", "resolution_percentage"), ("prop", "output_path")} <= set(seen)
+
+        # Opening another file forgets the last render (its times would describe another scene).
+        bpy.ops.wm.read_homefile(use_empty=True)
+        print("after load:", preview.state.last, preview.state.last_error)
+        assert preview.state.last is None and preview.state.last_error is None
+        assert not panel.VIEW3D_PT_bounce_gi_last_render.poll(ctx)
+    """)
+
+
+TINY_SCENE = """
+for ob in list(bpy.data.objects):
+    bpy.data.objects.remove(ob)
+scene = bpy.context.scene
+bpy.ops.mesh.primitive_cube_add(size=2.0)
+sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
+sun.data.energy = 3.0
+sun.rotation_euler = (0.6, 0.2, 0.3)
+scene.collection.objects.link(sun)
+cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+cam.location = (6.0, -6.0, 4.5)
+cam.rotation_euler = (1.1, 0.0, 0.785)
+scene.collection.objects.link(cam)
+scene.camera = cam
+scene.render.resolution_x, scene.render.resolution_y, scene.render.resolution_percentage = 64, 48, 100
+scene.bounce_gi.resolution_percentage = 50
+"""
+
+
+def test_render_preview_end_to_end(tmp_path):
+    out = run_case(tmp_path, setup=TINY_SCENE, body="""
+        # The operator's blocking path (what a script or background job gets).
+        print("operator", bpy.ops.bounce_gi.render_preview())
+        img = bpy.data.images["Bounce GI Preview"]
+        px = np.empty(img.size[0] * img.size[1] * 4, np.float32); img.pixels.foreach_get(px)
+        last = preview.state.last
+        print("image", tuple(img.size), "max", px.max(), "timings", last.timings, "warnings", last.warnings)
+        assert tuple(img.size) == (32, 24)            # 64x48 at 100 %, preview at 50 %
+        assert np.isfinite(px).all() and px.reshape(-1, 4)[:, :3].max() > 0.0  # the lit cube shows
+        assert "total" in last.timings and (last.width, last.height) == (32, 24)
+
+        # The same steps as plain functions (what invoke/modal schedule), at another size.
+        scene.bounce_gi.resolution_percentage = 25
+        pending = preview.start_render(scene, bpy.context.evaluated_depsgraph_get())
+        report = preview.finish_render(pending, timeout=120)
+        print("plain", report.width, report.height, tuple(img.size))
+        assert tuple(img.size) == (16, 12) and (report.width, report.height) == (16, 12)
+    """)
+    assert "CASE OK" in out
+
+
+def test_errors_are_one_line_reports(tmp_path):
+    run_case(tmp_path, setup=TINY_SCENE, body="""
+        def op_error():
+            try:
+                bpy.ops.bounce_gi.render_preview()
+            except RuntimeError as ex:   # how bpy.ops surfaces self.report({'ERROR'}) + CANCELLED
+                return str(ex)
+            raise AssertionError("the operator did not report an error")
+
+        scene.bounce_gi.method = "LPV"    # the engine raises NotImplementedError for now
+        msg = op_error(); print("LPV:", msg)
+        assert "not implemented" in msg.lower() and "Traceback" not in msg and msg.count("\\n") <= 1
+        scene.bounce_gi.method = "NONE"
+        scene.camera = None
+        msg = op_error(); print("no camera:", msg)
+        assert "camera" in msg.lower() and "Traceback" not in msg and msg.count("\\n") <= 1
+        assert preview.state.busy is False
+    """)
+
+
+def test_modal_path_with_simulated_events(tmp_path):
+    # invoke()/modal() need a window, which background mode lacks; drive them with stand-ins for
+    # context, window manager and events. The class's methods are plain functions, so a stand-in
+    # `self` borrows them (a bpy Operator cannot be instantiated outside an operator call).
+    run_case(tmp_path, setup=TINY_SCENE, body="""
+        import time
+        from types import SimpleNamespace
+        from bounce_gi.ui.operators import BOUNCE_GI_OT_render_preview as Op
+
+        log = []
+        class WM:
+            windows = []
+            def event_timer_add(self, step, window=None): log.append("timer+"); return "timer"
+            def event_timer_remove(self, timer): log.append("timer-")
+            def modal_handler_add(self, op): log.append("handler")
+        class Workspace:
+            def status_text_set(self, text): log.append(("status", text))
+        class FakeOp:
+            invoke, modal, cancel, _fail, _progress, _cleanup = Op.invoke, Op.modal, Op.cancel, Op._fail, \\
+                Op._progress, Op._cleanup
+            _pending = None
+            def report(self, kind, msg): log.append((sorted(kind)[0], msg))
+        ctx = SimpleNamespace(scene=scene, window=None, window_manager=WM(), workspace=Workspace(),
+                              evaluated_depsgraph_get=bpy.context.evaluated_depsgraph_get)
+        timer, esc = SimpleNamespace(type="TIMER", value="NOTHING"), SimpleNamespace(type="ESC", value="PRESS")
+
+        op = FakeOp()
+        assert op.invoke(ctx, None) == {"RUNNING_MODAL"} and preview.state.busy
+        assert not Op.poll(bpy.context)   # a second preview cannot start meanwhile
+        deadline, ret = time.time() + 120, {"PASS_THROUGH"}
+        while ret == {"PASS_THROUGH"} and time.time() < deadline:
+            time.sleep(0.02)
+            ret = op.modal(ctx, timer)
+        print(ret, log)
+        assert ret == {"FINISHED"} and not preview.state.busy and preview.state.timer is None
+        assert log.count("timer+") == log.count("timer-") == 1 and log[-3][0] == "status"
+        assert any(kind == "INFO" for kind, *_ in log if isinstance(kind, str) and kind.isupper())
+        assert tuple(bpy.data.images["Bounce GI Preview"].size) == (32, 24)
+
+        # Esc stops waiting: timer removed, status cleared, the operator cancelled.
+        log.clear()
+        op = FakeOp()
+        assert op.invoke(ctx, None) == {"RUNNING_MODAL"}
+        assert op.modal(ctx, esc) == {"CANCELLED"} and not preview.state.busy
+        print(log)
+        assert "timer-" in log and ("status", None) in log and preview.state.last_error == "Cancelled"
+        import concurrent.futures   # cancelled if still queued, else let it finish before exiting
+        concurrent.futures.wait([op._pending.future], timeout=120)
+    """)

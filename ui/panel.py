@@ -1,0 +1,98 @@
+"""Sidebar panels in the 3D View (N panel, tab "Bounce GI"): settings, render button, last result.
+
+Panels only read state; everything they show about the last render comes from
+`preview.state`, which lives in memory and is never written into the .blend.
+"""
+import bpy
+from bpy.types import Panel
+
+from . import preview
+
+
+def _format_seconds(seconds: float) -> str:
+    # Passes range from microseconds to seconds on a software rasteriser; ms reads best.
+    return f"{seconds * 1000:.1f} ms" if seconds < 10 else f"{seconds:.1f} s"
+
+
+class VIEW3D_PT_bounce_gi(Panel):
+    """Bounce GI settings and the Render Preview button."""
+
+    bl_space_type = "VIEW_3D"
+    bl_region_type = "UI"
+    bl_category = "Bounce GI"
+    bl_label = "Bounce GI"
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        settings = context.scene.bounce_gi
+
+        layout.prop(settings, "method")
+        layout.prop(settings, "resolution_percentage")
+        layout.prop(settings, "output_path")
+
+        row = layout.row()
+        row.scale_y = 1.4
+        if preview.state.busy:
+            # The operator's poll() greys the button out; say why right here as well.
+            row.enabled = False
+            row.operator("bounce_gi.render_preview", text="Rendering...", icon="TIME")
+        else:
+            row.operator("bounce_gi.render_preview", icon="RENDER_STILL")
+        if preview.state.last_error:
+            layout.label(text=preview.state.last_error, icon="ERROR")
+
+
+class VIEW3D_PT_bounce_gi_last_render(Panel):
+    """Per-pass times and warnings of the last finished preview."""
+
+    bl_space_type = "VIEW_3D"
+    bl_region_type = "UI"
+    bl_category = "Bounce GI"
+    bl_label = "Last Render"
+    bl_parent_id = "VIEW3D_PT_bounce_gi"
+
+    @classmethod
+    def poll(cls, context):
+        return preview.state.last is not None
+
+    def draw(self, context):
+        layout = self.layout
+        last = preview.state.last
+        layout.label(text=f"{last.method.upper()}  {last.width} x {last.height}", icon="IMAGE_DATA")
+
+        col = layout.column(align=True)
+        # Engine order is pipeline order; "total" goes last, then the wall time the user waited.
+        for name, seconds in last.timings.items():
+            if name != "total":
+                split = col.split(factor=0.6)
+                split.label(text=name)
+                # A pass whose inputs did not change is reused, not re-run: say so instead of "0.0 ms".
+                split.label(text="cached" if name in last.skipped else _format_seconds(seconds))
+        if "total" in last.timings:
+            split = col.split(factor=0.6)
+            split.label(text="Total (engine)")
+            split.label(text=_format_seconds(last.timings["total"]))
+        split = col.split(factor=0.6)
+        split.label(text="Waited")
+        split.label(text=_format_seconds(last.wall_seconds))
+
+        if last.warnings:
+            box = layout.box()
+            box_col = box.column(align=True)
+            for text in last.warnings:
+                box_col.label(text=text, icon="ERROR")
+
+
+classes = (VIEW3D_PT_bounce_gi, VIEW3D_PT_bounce_gi_last_render)
+
+
+def register():
+    for cls in classes:
+        bpy.utils.register_class(cls)
+
+
+def unregister():
+    for cls in reversed(classes):
+        bpy.utils.unregister_class(cls)

@@ -1,0 +1,200 @@
+"""The steps of a preview render as plain functions, and the runtime state of the last one.
+
+The operator (operators.py) only schedules these steps: start_render() extracts the scene and
+submits it to the engine, finish_render() waits for the Future and writes the image. Keeping
+them plain lets tests run a whole preview in background mode, where modal operators never run.
+
+Engine and extraction modules are imported inside the functions, so registering the UI never
+needs moderngl (a missing wheel shows up as one error line when rendering, not as a failed
+register()).
+"""
+from __future__ import annotations
+
+import time
+import traceback
+from dataclasses import dataclass, field
+
+import bpy
+import numpy as np
+
+IMAGE_NAME = "Bounce GI Preview"
+
+
+class PreviewError(Exception):
+    """A failure with a one-line message meant for the user (operators report it as is)."""
+
+
+@dataclass
+class RenderReport:
+    """What the panel shows about the last finished render."""
+    method: str
+    width: int
+    height: int
+    timings: dict  # pass name -> seconds, plus "total" (the engine's own measurement)
+    warnings: list
+    wall_seconds: float  # submit to image written, as the user waited for it
+    skipped: list = field(default_factory=list)  # passes reused from the engine's cache (time 0)
+
+
+@dataclass
+class RuntimeState:
+    """Module-level state, deliberately not a bpy property: it must never be saved in a .blend."""
+    busy: bool = False
+    last: RenderReport | None = None
+    last_error: str | None = None
+    timer: object | None = None  # the modal operator's window-manager timer, removed on unregister
+
+
+state = RuntimeState()
+
+
+@bpy.app.handlers.persistent
+def forget_last_render(_dummy=None) -> None:
+    """load_post handler: times and warnings of another file's render would mislead."""
+    state.last = None
+    state.last_error = None
+
+
+@dataclass
+class PendingRender:
+    """A render submitted to the engine and not yet written into the image."""
+    future: object  # concurrent.futures.Future resolving to a RenderResult
+    method: str
+    width: int
+    height: int
+    scene_warnings: list = field(default_factory=list)
+    started: float = field(default_factory=time.perf_counter)
+
+    def elapsed(self) -> float:
+        return time.perf_counter() - self.started
+
+
+def one_line(ex: BaseException) -> str:
+    """An exception as a single line for self.report() (reports show only the first line well)."""
+    text = " ".join(str(ex).split())
+    return text or type(ex).__name__
+
+
+def _unexpected(ex: BaseException, during: str) -> PreviewError:
+    # The console gets the traceback (for bug reports); the user gets one line.
+    traceback.print_exc()
+    return PreviewError(f"Bounce GI {during} failed: {type(ex).__name__}: {one_line(ex)}")
+
+
+def _user_facing_errors() -> tuple:
+    """Engine exceptions whose message is written for the user (reported as is, no traceback)."""
+    from ..gpu_kernels.gpu_context import GpuUnavailableError
+    from ..gpu_kernels.pipeline import SceneError
+
+    return (SceneError, GpuUnavailableError)
+
+
+def _not_implemented(ex: NotImplementedError, method: str) -> PreviewError:
+    return PreviewError(one_line(ex) if str(ex) else f"Method {method!r} is not implemented yet")
+
+
+def preview_resolution(scene, percentage: int) -> tuple[int, int]:
+    """The scene's render size (after its own percentage) scaled by the preview percentage."""
+    r = scene.render
+    scale = r.resolution_percentage / 100.0 * percentage / 100.0
+    return max(1, round(r.resolution_x * scale)), max(1, round(r.resolution_y * scale))
+
+
+def start_render(scene, depsgraph) -> PendingRender:
+    """Extract `scene` (must run on the main thread) and submit it; returns without waiting."""
+    try:
+        from ..addon.extract import ExtractError, extract_scene
+        from ..gpu_kernels.engine import get_engine
+        from ..gpu_kernels.pipeline import RenderSettings
+    except ImportError as ex:
+        raise PreviewError(f"Bounce GI engine unavailable: {one_line(ex)}") from None
+
+    settings = scene.bounce_gi
+    method = settings.method_id()
+    width, height = preview_resolution(scene, settings.resolution_percentage)
+    try:
+        scene_data = extract_scene(depsgraph, resolution=(width, height))
+    except ExtractError as ex:
+        raise PreviewError(one_line(ex)) from None
+    except Exception as ex:
+        raise _unexpected(ex, "scene extraction") from None
+    # Extraction owns the final size (it may clamp it); render exactly what it describes.
+    width, height = (int(v) for v in scene_data.resolution)
+    try:
+        future = get_engine().submit_render(scene_data, RenderSettings(method=method, width=width, height=height))
+    except NotImplementedError as ex:
+        raise _not_implemented(ex, method) from None
+    except _user_facing_errors() as ex:
+        raise PreviewError(one_line(ex)) from None
+    except Exception as ex:
+        raise _unexpected(ex, "render submission") from None
+    return PendingRender(future, method, width, height, list(scene_data.warnings))
+
+
+def finish_render(pending: PendingRender, timeout: float | None = None) -> RenderReport:
+    """Wait for the engine, write the Combined pass into the preview image, record the report."""
+    import concurrent.futures
+
+    try:
+        result = pending.future.result(timeout=timeout)
+    except NotImplementedError as ex:
+        raise _not_implemented(ex, pending.method) from None
+    except _user_facing_errors() as ex:
+        raise PreviewError(one_line(ex)) from None
+    except concurrent.futures.CancelledError:
+        raise PreviewError("Bounce GI render was cancelled") from None
+    except concurrent.futures.TimeoutError:
+        raise PreviewError(f"Bounce GI render did not finish within {timeout:g} s") from None
+    except Exception as ex:
+        raise _unexpected(ex, "render") from None
+
+    if "Combined" not in result.passes:
+        raise PreviewError(f"Bounce GI engine returned no Combined pass (got {sorted(result.passes)})")
+    write_preview_image(result.passes["Combined"])
+    # Scene warnings first (they explain the render), then the engine's; drop repeats, keep order.
+    warnings = list(dict.fromkeys([*pending.scene_warnings, *result.warnings]))
+    report = RenderReport(pending.method, pending.width, pending.height, dict(result.timings), warnings,
+                          pending.elapsed(), list(getattr(result, "skipped", [])))
+    state.last, state.last_error = report, None
+    return report
+
+
+def write_preview_image(combined: np.ndarray, name: str = IMAGE_NAME):
+    """Copy an (H, W, 3|4) float array, rows top-to-bottom, into a float Image datablock.
+
+    The datablock is reused (resized when needed) rather than replaced, so an Image Editor that
+    shows it keeps showing it. Float buffers hold scene-linear values, which is what the engine
+    produces; no view transform is baked in.
+    """
+    a = np.asarray(combined, dtype=np.float32)
+    if a.ndim != 3 or a.shape[2] not in (3, 4) or a.shape[0] < 1 or a.shape[1] < 1:
+        raise PreviewError(f"Bounce GI Combined pass has shape {a.shape}, expected (H, W, 3 or 4)")
+    h, w = a.shape[:2]
+    if a.shape[2] == 3:
+        a = np.concatenate([a, np.ones((h, w, 1), np.float32)], axis=2)
+    # Blender stores pixels bottom row first; the engine gives rows top to bottom.
+    rgba = np.ascontiguousarray(a[::-1])
+
+    img = bpy.data.images.get(name)
+    if img is not None and (img.source != "GENERATED" or not img.is_float):
+        # A file, or a byte image (sRGB colour space) with our name: keep it, under another name.
+        img.name = name + " (old)"
+        img = None
+    if img is None:
+        # A new float buffer gets the scene-linear colour space.
+        img = bpy.data.images.new(name, width=w, height=h, alpha=True, float_buffer=True)
+    elif tuple(img.size) != (w, h):
+        # Changing the generated size re-creates the pixel buffer in place (keeps editors' references).
+        img.generated_width, img.generated_height = w, h
+    img.pixels.foreach_set(rgba.ravel())
+    img.update()
+    return img
+
+
+def tag_redraw_all(area_types=("VIEW_3D", "IMAGE_EDITOR")) -> None:
+    """Redraw the sidebar (times, warnings) and any Image Editor showing the preview."""
+    wm = bpy.context.window_manager
+    for window in getattr(wm, "windows", ()):
+        for area in window.screen.areas:
+            if area.type in area_types:
+                area.tag_redraw()
