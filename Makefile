@@ -32,7 +32,7 @@ system-libs:
 	fi
 
 demo: setup
-	$(VENV)/bin/bounce-gi demo --out out/demo
+	$(PY) examples/demo.py --out out/demo
 
 test: setup
 	$(PY) -m pytest -q

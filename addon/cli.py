@@ -9,7 +9,7 @@ import argparse
 import json
 import os
 import sys
-import time
+import tempfile
 
 EXIT_BAD_INPUT = 2
 EXIT_INTERNAL = 1
@@ -47,11 +47,28 @@ def check_output_path(path: str, suffix: str) -> str:
     parent = os.path.dirname(path)
     if os.path.isdir(path):
         raise CliError(f"{path}: is a directory")
+    if os.path.exists(parent) and not os.path.isdir(parent):
+        raise CliError(f"{path}: {parent} is not a directory")
     if not os.path.isdir(parent):
         raise CliError(f"{path}: directory {parent} does not exist")
-    if not os.access(parent, os.W_OK) or (os.path.exists(path) and not os.access(path, os.W_OK)):
+    if os.path.exists(path) and not os.access(path, os.W_OK):
         raise CliError(f"{path}: not writable")
+    # os.access() says yes to root even where nothing can be created (procfs, read-only mounts): try it.
+    try:
+        fd, probe = tempfile.mkstemp(prefix=".bounce-gi-probe-", dir=parent)
+    except OSError as exc:
+        raise CliError(f"{path}: not writable ({exc.strerror})") from None
+    os.close(fd)
+    os.unlink(probe)
     return path
+
+
+def write_output(writer, path: str, *args) -> None:
+    """Run an image writer; a failure (disk full, permissions changed meanwhile) is a one-line user error."""
+    try:
+        writer(path, *args)
+    except OSError as exc:
+        raise CliError(f"{path}: cannot write ({exc})") from None
 
 
 def load_scene(path: str, resolution=None):
@@ -89,14 +106,16 @@ def render_ours(scene, method: str):
 
 
 def cmd_render(args) -> dict:
-    out = check_output_path(args.out, ".exr") if args.out else None
+    if args.out:
+        out = check_output_path(args.out, ".exr")
+    else:
+        check_blend_path(args.scene)
+        out = check_output_path(os.path.splitext(os.path.abspath(args.scene))[0] + f"_bounce_{args.method}.exr", ".exr")
     scene = load_scene(args.scene, tuple(args.res) if args.res else None)
     result = render_ours(scene, args.method)
-    if out is None:
-        out = check_output_path(os.path.splitext(os.path.abspath(args.scene))[0] + f"_bounce_{args.method}.exr", ".exr")
     from ..gpu_kernels import exr_io
 
-    exr_io.write_passes(out, result.passes)
+    write_output(exr_io.write_passes, out, result.passes)
     report = {"method": result.method, "resolution": list(result.resolution),
               "seconds": {k: round(v, 6) for k, v in result.timings.items()}, "skipped": result.skipped,
               "scene": result.statistics, "warnings": result.warnings, "output": out}
@@ -161,7 +180,7 @@ def cmd_compare(args) -> dict:
         from ..gpu_kernels import exr_io, metrics
 
         err = metrics.relative_error_map(result.passes["Combined"], ref.passes["Combined"]) * mask
-        exr_io.write_png(heatmap, metrics.heatmap_rgb8(err))
+        write_output(exr_io.write_png, heatmap, metrics.heatmap_rgb8(err))
         report["heatmap"] = heatmap
     if not args.json:
         print(format_compare(report))
@@ -182,10 +201,17 @@ def format_compare(report: dict) -> str:
     return "\n".join(lines)
 
 
+class _ArgumentParser(argparse.ArgumentParser):
+    """argparse, but a usage error is one line on stderr and exit code 2 like every other bad input."""
+
+    def error(self, message):
+        self.exit(EXIT_BAD_INPUT, f"bounce-gi: error: {message} (see bounce-gi --help)\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
     from ..gpu_kernels.pipeline import METHODS
 
-    parser = argparse.ArgumentParser(prog="bounce-gi", description=__doc__.splitlines()[0])
+    parser = _ArgumentParser(prog="bounce-gi", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True)
     r = sub.add_parser("render", help="render a .blend from its scene camera into a multi-layer EXR")
     r.add_argument("scene")
@@ -210,7 +236,7 @@ def main(argv=None) -> int:
     parser = build_parser()
     try:
         args = parser.parse_args(argv)
-    except SystemExit as exc:  # argparse already printed one usage line; make it exit 2 consistently
+    except SystemExit as exc:  # --help (exit 0) or a usage error already printed as one line (exit 2)
         return int(exc.code) if exc.code else 0
     try:
         if args.res and (args.res[0] < 1 or args.res[1] < 1):

@@ -422,6 +422,34 @@ def textured():
     _sun()
 
 
+def principled_material(name, color, roughness, metallic=0.0):
+    """Material with a single Principled BSDF (IOR 1.5, Specular IOR Level 0.5 — Blender's defaults)."""
+    mat = bpy.data.materials.new(name)
+    mat.use_nodes = True
+    nodes = mat.node_tree.nodes
+    bsdf = next(n for n in nodes if n.bl_idname == "ShaderNodeBsdfPrincipled")
+    bsdf.inputs["Base Color"].default_value = (*color, 1.0)
+    bsdf.inputs["Roughness"].default_value = roughness
+    bsdf.inputs["Metallic"].default_value = metallic
+    mat.diffuse_color = (*color, 1.0)
+    return mat
+
+
+def principled():
+    """Stage with Principled BSDF materials (rough floor, glossy sphere, half-metallic cube), lit by the sun.
+
+    Checks the view-dependent Diffuse Color of Principled BSDF (its specular layer takes a share of the base).
+    """
+    quad("Floor", [(-3, -3, 0), (3, -3, 0), (3, 3, 0), (-3, 3, 0)], (0, 0, 1),
+         principled_material("RoughFloor", STAGE_WHITE, 0.8))
+    quad("BackWall", [(-3, 2, 0), (3, 2, 0), (3, 2, 3), (-3, 2, 3)], (0, -1, 0),
+         principled_material("Wall", STAGE_WHITE, 0.5))
+    box("Cube", (1.0, 1.0, 1.0), CUBE_LOCATION, 30.0, principled_material("HalfMetal", STAGE_CUBE, 0.4, 0.5))
+    uv_sphere("Sphere", 0.6, (1.2, -0.3, 0.6), principled_material("Glossy", STAGE_WHITE, 0.2))
+    _stage_camera()
+    _sun()
+
+
 def camera_shift():
     """Stage with a sun; camera rolled 15 deg, shift (0.1, -0.05), sensor fit VERTICAL."""
     _stage()
@@ -585,6 +613,7 @@ SCENES = {
     "light_area_disk": light_area_disk,
     "light_mixed": light_mixed,
     "textured": textured,
+    "principled": principled,
     "camera_shift": camera_shift,
     "camera_ortho": camera_ortho,
     "extraction": extraction,

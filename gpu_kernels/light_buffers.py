@@ -40,6 +40,7 @@ class ShadowSettings:
     sample_cube_resolution: int = 256  # per face, area/emissive sample points
     area_samples: int = 2  # n×n shadow sample points on square/rectangle lights (n² ring points on disks)
     max_shadowed_emissive: int = 16  # emissive triangles beyond this light unshadowed (a warning says so)
+    emissive_sample_budget: int = 64  # shadow cubes for all emissive triangles together
     pcf_radius: int = 1  # PCF kernel (2r+1)²
 
 
@@ -114,6 +115,15 @@ def area_sample_points(light: Light, n: int) -> np.ndarray:
             local = np.stack([r * np.cos(t) * sx / 2, r * np.sin(t) * sy / 2], axis=1)
     pts = np.concatenate([local, np.zeros((len(local), 1)), np.ones((len(local), 1))], axis=1) @ m.T
     return pts[:, :3]
+
+
+def triangle_sample_points(tri: np.ndarray, count: int) -> np.ndarray:
+    """1 point (the centroid) or 4 (centroids of the four midpoint sub-triangles) on a triangle."""
+    if count == 1:
+        return tri.mean(axis=0, keepdims=True)
+    a, b, c = tri
+    ab, bc, ca = (a + b) / 2, (b + c) / 2, (c + a) / 2
+    return np.array([(a + ab + ca) / 3, (ab + b + bc) / 3, (ca + bc + c) / 3, (ab + bc + ca) / 3])
 
 
 def _scene_radius(scene: Scene) -> tuple[np.ndarray, float]:
@@ -230,19 +240,25 @@ def build_light_buffers(scene: Scene, settings: ShadowSettings | None = None) ->
             warnings.append(f"light '{light.name}' of type {light.type} is not supported and is ignored")
 
     tri_idx, radiance = emissive_triangles(scene)
+    shadowed = min(len(tri_idx), s.max_shadowed_emissive)
+    # Few emitters get 4 shadow points per side (centroids of the midpoint subdivision) for softer, truer
+    # penumbrae; many get one, so the number of shadow cubes stays within the budget.
+    per_side = 4 if shadowed * 2 * 4 <= s.emissive_sample_budget else 1
     for rank, (t, rad) in enumerate(zip(tri_idx, radiance)):
         tri = scene.positions[t].astype(np.float64)
         centroid = tri.mean(axis=0)
         normal = np.cross(tri[1] - tri[0], tri[2] - tri[0])
         normal /= np.linalg.norm(normal)
         v, samples = [], 0
-        if rank < s.max_shadowed_emissive:
-            # One sample point per side, nudged off the surface so the triangle does not shadow itself.
+        if rank < shadowed:
+            # Sample points nudged off the surface so the triangle does not shadow itself; they alternate sides
+            # (even: along the normal, odd: against it) as direct_light.glsl expects of two-sided emitters.
             eps = 1e-3 * max(float(np.linalg.norm(tri[1] - tri[0])), 1e-3)
-            for side in (1.0, -1.0):
-                point = centroid + side * eps * normal
-                v.extend(cube_views(point, s.sample_cube_resolution, *_near_far(scene, point)))
-                samples += 1
+            for point in triangle_sample_points(tri, per_side):
+                for side in (1.0, -1.0):
+                    p = point + side * eps * normal
+                    v.extend(cube_views(p, s.sample_cube_resolution, *_near_far(scene, p)))
+                    samples += 1
         add(LIGHT_POLYGON, rad, centroid, 0.0, normal, light_views=v, samples=samples, per=6, poly=tri,
             two_sided=True)
     if len(tri_idx) > s.max_shadowed_emissive:
@@ -264,14 +280,19 @@ def pack_views(views: list[ShadowView], tiles: list[tuple], atlas_size: tuple[in
         out[i]["view_projection"] = v.view_projection.T
         out[i]["tile"] = (x / aw, y / ah, w / aw, h / ah)
         out[i]["origin"] = (*v.origin, 1.0 if v.ortho else 0.0)
-        out[i]["info"] = (v.texel_world, pcf_radius, v.far, 0)
+        # The atlas may have shrunk the tile: a texel then covers resolution/w times more ground.
+        out[i]["info"] = (v.texel_world * v.resolution / w, pcf_radius, v.far, 0)
     return out
 
 
 def allocate_atlas(resolutions: list[int], width: int = 4096, max_height: int = 16384):
     """Shelf-pack square tiles (largest first). Returns (tiles in input order, atlas size, scale applied)."""
     scale = 1
+    while max(resolutions, default=0) // scale > width:  # a tile must fit the atlas width
+        scale *= 2
     while True:
+        if scale > 1 << 16:
+            raise ValueError(f"{len(resolutions)} shadow views do not fit a {width}x{max_height} atlas")
         res = [max(16, r // scale) for r in resolutions]
         order = sorted(range(len(res)), key=lambda i: -res[i])
         tiles = [None] * len(res)

@@ -27,6 +27,7 @@ EXPECTED_COUNTS = {
     "light_area_disk": (4, 1, 0, 0),
     "light_mixed": (4, 4, 0, 0),
     "textured": (4, 1, 0, 0),
+    "principled": (4, 1, 0, 0),
     "camera_shift": (4, 1, 0, 0),
     "camera_ortho": (4, 1, 0, 0),
     "extraction": (5, 1, 3, 0),
@@ -195,7 +196,7 @@ def test_scene_basics(data, name):
     assert counts == EXPECTED_COUNTS[name]
     for mat, nodes in s["node_types"].items():
         assert "ShaderNodeOutputMaterial" in nodes, mat
-        assert {"ShaderNodeBsdfDiffuse", "ShaderNodeEmission"} & set(nodes), (mat, nodes)
+        assert {"ShaderNodeBsdfDiffuse", "ShaderNodeBsdfPrincipled", "ShaderNodeEmission"} & set(nodes), (mat, nodes)
     for light in s["lights"].values():
         assert light["color"] == [1.0, 1.0, 1.0]
 

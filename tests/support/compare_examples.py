@@ -1,0 +1,32 @@
+"""Render example scenes with Bounce GI and with Cycles (two seeds) and print one JSON line of errors.
+
+Run in a subprocess by tests/test_direct_vs_cycles.py so bpy's global state stays out of the pytest process:
+    python tests/support/compare_examples.py SAMPLES NAME [NAME...]
+"""
+import json
+import os
+import sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", ".."))
+
+from bounce_gi.addon.cli import compare  # noqa: E402
+from bounce_gi.addon.extract import extract_scene  # noqa: E402
+from examples import scenes  # noqa: E402
+
+
+def main():
+    import bpy
+
+    samples = int(sys.argv[1])
+    out = {}
+    for name in sys.argv[2:]:
+        scenes.build(name)
+        scene = extract_scene(bpy.context.evaluated_depsgraph_get())
+        report, *_ = compare(scene, "none", samples, progress=lambda m: None)
+        out[name] = report
+    sys.stdout.flush()
+    print("RESULT " + json.dumps(out), flush=True)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,269 @@
+"""gpu_kernels.pass_cache: skip what did not change, release what is replaced; and the real pipeline re-running
+exactly the passes downstream of a change (design.md §2), with the direct light checked against the analytic value."""
+import math
+import time
+
+import numpy as np
+import pytest
+
+from bounce_gi.gpu_kernels.light_buffers import ShadowSettings
+from bounce_gi.gpu_kernels.pass_cache import PassCache
+from bounce_gi.gpu_kernels.scene import Camera, Light, Material, Scene
+
+
+class Resource:
+    """Stands in for a GL object: counts release() calls."""
+
+    def __init__(self, tag):
+        self.tag = tag
+        self.released = 0
+
+    def release(self):
+        self.released += 1
+
+
+class Counter:
+    def __init__(self):
+        self.calls = {}
+
+    def fn(self, name, value):
+        def run():
+            self.calls[name] = self.calls.get(name, 0) + 1
+            return value
+        return run
+
+
+# --------------------------------------------------------------------------- PassCache with fakes
+
+def test_same_key_skips_and_returns_cached_value():
+    cache, c = PassCache(), Counter()
+    first = Resource("a")
+    cache.begin_frame()
+    assert cache.run("a", ("k",), c.fn("a", first)) is first
+    assert cache.skipped == [] and cache.timings["a"] >= 0.0
+    cache.begin_frame()
+    again = cache.run("a", ("k",), c.fn("a", Resource("never")))
+    assert again is first and c.calls["a"] == 1
+    assert cache.timings == {"a": 0.0} and cache.skipped == ["a"]
+    assert first.released == 0
+
+
+def test_changed_key_reruns_and_releases_old_value():
+    cache, c = PassCache(), Counter()
+    old = {"tex": Resource("t"), "list": [Resource("l1"), (Resource("l2"),)], "plain": 3}
+    cache.run("a", (1,), c.fn("a", old))
+    new = Resource("new")
+    cache.begin_frame()
+    assert cache.run("a", (2,), c.fn("a", new)) is new
+    assert c.calls["a"] == 2 and cache.skipped == []
+    # Nested resources in the old output were each released exactly once; the new one is alive.
+    assert (old["tex"].released, old["list"][0].released, old["list"][1][0].released) == (1, 1, 1)
+    assert new.released == 0
+    # Re-running to the very same object (a pass that returns a persistent resource) must not release it.
+    cache.run("a", (3,), c.fn("a", new))
+    assert new.released == 0
+    cache.clear()
+    assert new.released == 1 and cache.entries == {}
+
+
+def test_timing_measures_the_pass_and_waits_for_finish():
+    finished = []
+    cache = PassCache(finish=lambda: (time.sleep(0.02), finished.append(1)))
+    cache.begin_frame()
+    cache.run("slow", (1,), lambda: time.sleep(0.03))
+    assert finished == [1]
+    assert cache.timings["slow"] >= 0.045  # the pass plus the GPU wait, not just the Python call
+    cache.begin_frame()
+    cache.run("slow", (1,), lambda: time.sleep(0.03))
+    assert finished == [1] and cache.timings == {"slow": 0.0}  # a skipped pass does not wait for the GPU
+
+
+def _graph(cache, counter, inputs):
+    """a ← x; b ← a, y; c ← b. Keys of downstream passes contain the keys of what they consume."""
+    ka = (inputs["x"],)
+    cache.run("a", ka, counter.fn("a", Resource("a")))
+    kb = (ka, inputs["y"])
+    cache.run("b", kb, counter.fn("b", Resource("b")))
+    kc = (kb,)
+    cache.run("c", kc, counter.fn("c", Resource("c")))
+
+
+def test_downstream_keys_rerun_transitively():
+    cache, c = PassCache(), Counter()
+    inputs = {"x": "x0", "y": "y0"}
+    _graph(cache, c, inputs)
+    assert c.calls == {"a": 1, "b": 1, "c": 1}
+    cache.begin_frame()
+    _graph(cache, c, inputs)
+    assert c.calls == {"a": 1, "b": 1, "c": 1} and cache.skipped == ["a", "b", "c"]
+    cache.begin_frame()
+    _graph(cache, c, {**inputs, "y": "y1"})  # only b's own input: a skipped, b and c re-run
+    assert c.calls == {"a": 1, "b": 2, "c": 2} and cache.skipped == ["a"]
+    cache.begin_frame()
+    _graph(cache, c, {"x": "x1", "y": "y1"})  # a's input: everything downstream re-runs
+    assert c.calls == {"a": 2, "b": 3, "c": 3} and cache.skipped == []
+
+
+# --------------------------------------------------------------------------- the real pipeline
+
+SUN_STRENGTH = 3.0
+FLOOR_ALBEDO = (0.5, 0.4, 0.3)
+BOX = (np.array([-0.5, -0.5, 0.0]), np.array([0.5, 0.5, 1.0]))
+ALL_PASSES = {"geometry", "textures", "shadow_maps", "gbuffer", "direct_light", "compose"}
+
+
+def _quad(a, b, c, d, normal):
+    pos = np.array([[a, b, c], [a, c, d]], np.float64)
+    nrm = np.broadcast_to(np.asarray(normal, np.float64), (2, 3, 3))
+    return pos, nrm
+
+
+def _box_triangles(lo, hi):
+    x0, y0, z0 = lo
+    x1, y1, z1 = hi
+    faces = [
+        (((x0, y0, z1), (x1, y0, z1), (x1, y1, z1), (x0, y1, z1)), (0, 0, 1)),
+        (((x0, y0, z0), (x0, y1, z0), (x1, y1, z0), (x1, y0, z0)), (0, 0, -1)),
+        (((x1, y0, z0), (x1, y1, z0), (x1, y1, z1), (x1, y0, z1)), (1, 0, 0)),
+        (((x0, y0, z0), (x0, y0, z1), (x0, y1, z1), (x0, y1, z0)), (-1, 0, 0)),
+        (((x0, y1, z0), (x0, y1, z1), (x1, y1, z1), (x1, y1, z0)), (0, 1, 0)),
+        (((x0, y0, z0), (x1, y0, z0), (x1, y0, z1), (x0, y0, z1)), (0, -1, 0)),
+    ]
+    return [_quad(*corners, n) for corners, n in faces]
+
+
+def _rotation_x(angle):
+    c, s = math.cos(angle), math.sin(angle)
+    m = np.eye(4)
+    m[1:3, 1:3] = [[c, -s], [s, c]]
+    return m
+
+
+def sun(tilt_deg, location=(0, 0, 5)):
+    """A sun tilted `tilt_deg` from straight down (about X): the floor's cosθ is cos(tilt)."""
+    m = _rotation_x(math.radians(tilt_deg))
+    m[:3, 3] = location
+    return Light("sun", "SUN", (1.0, 1.0, 1.0), SUN_STRENGTH, m)
+
+
+def camera(eye, target=(0, 0, 0)):
+    """Camera-to-world matrix looking from eye to target (+Y up-ish), built by hand."""
+    eye, target = np.asarray(eye, np.float64), np.asarray(target, np.float64)
+    back = eye - target
+    back /= np.linalg.norm(back)
+    right = np.cross([0, 0, 1.0], back)
+    right /= np.linalg.norm(right)
+    up = np.cross(back, right)
+    m = np.eye(4)
+    m[:3, 0], m[:3, 1], m[:3, 2], m[:3, 3] = right, up, back, eye
+    return Camera(matrix_world=m, lens=30.0, clip_start=0.1, clip_end=100.0)
+
+
+def make_scene(light, cam):
+    quads = [_quad((-5, -5, 0), (5, -5, 0), (5, 5, 0), (-5, 5, 0), (0, 0, 1))] + _box_triangles(*BOX)
+    pos = np.concatenate([q[0] for q in quads]).astype(np.float32)
+    nrm = np.concatenate([q[1] for q in quads]).astype(np.float32)
+    mat = np.array([0, 0] + [1] * 12, np.int32)
+    return Scene(pos, nrm, np.zeros((len(pos), 3, 2), np.float32), mat,
+                 [Material("floor", FLOOR_ALBEDO), Material("box", (0.8, 0.3, 0.2))],
+                 lights=[light], camera=cam, resolution=(160, 120))
+
+
+@pytest.fixture(scope="module")
+def engine():
+    from bounce_gi.gpu_kernels.engine import Engine
+    from bounce_gi.gpu_kernels.gpu_context import GpuUnavailableError
+
+    eng = Engine()
+    try:
+        eng.gl_info()
+    except GpuUnavailableError as exc:
+        eng.worker.shutdown()
+        pytest.skip(str(exc))
+    yield eng
+    if eng._pipeline is not None:
+        eng.worker.call(lambda ctx: eng._pipeline.release())
+    eng.worker.shutdown()
+
+
+@pytest.fixture(scope="module")
+def settings():
+    from bounce_gi.gpu_kernels.pipeline import RenderSettings
+
+    return RenderSettings(method="none", width=160, height=120,
+                          shadow=ShadowSettings(sun_resolution=512, spot_resolution=256, cube_resolution=128,
+                                                sample_cube_resolution=64))
+
+
+def _ray_hits_box(p, d, lo, hi):
+    """Slab test: does the ray p + t·d (t > 0) hit the axis-aligned box [lo, hi]?"""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t0 = (lo - p) / d
+        t1 = (hi - p) / d
+    tmin = np.nanmax(np.minimum(t0, t1), axis=-1)
+    tmax = np.nanmin(np.maximum(t0, t1), axis=-1)
+    return (tmax >= np.maximum(tmin, 0.0))
+
+
+def lit_floor_mask(passes, light, margin=0.25):
+    """Floor pixels whose path to the sun misses the box by at least `margin` (clear of PCF penumbrae)."""
+    pos = passes["Position"].reshape(-1, 3).astype(np.float64)
+    nrm = passes["Normal"].reshape(-1, 3)
+    floor = (np.abs(pos[:, 2]) < 1e-4) & (nrm[:, 2] > 0.999) & (np.abs(pos[:, :2]).max(axis=1) < 4.9)
+    lo, hi = BOX
+    blocked = _ray_hits_box(pos, np.broadcast_to(-light.direction, pos.shape), lo - margin, hi + margin)
+    return (floor & ~blocked).reshape(passes["Position"].shape[:2])
+
+
+def check_direct(passes, light, tilt_deg):
+    mask = lit_floor_mask(passes, light)
+    assert mask.sum() > 2000, "too few lit floor pixels to check"
+    expected = SUN_STRENGTH * math.cos(math.radians(tilt_deg)) / math.pi
+    got = passes["Diffuse Direct"][mask]
+    np.testing.assert_allclose(got, expected, rtol=1e-4)
+    np.testing.assert_allclose(passes["Diffuse Color"][mask], np.broadcast_to(FLOOR_ALBEDO, got.shape), rtol=1e-6)
+    # And the box's shadow really is there: floor pixels whose sun ray passes through the box (well inside).
+    pos = passes["Position"].reshape(-1, 3).astype(np.float64)
+    floor = (np.abs(pos[:, 2]) < 1e-4) & (passes["Normal"].reshape(-1, 3)[:, 2] > 0.999)
+    lo, hi = BOX
+    umbra = floor & _ray_hits_box(pos, np.broadcast_to(-light.direction, pos.shape), lo + 0.2, hi - 0.2)
+    assert umbra.sum() > 20
+    assert passes["Diffuse Direct"].reshape(-1, 3)[umbra].max() < 1e-3 * expected
+
+
+def test_pipeline_reruns_only_what_changed(engine, settings):
+    cam1 = camera((0.0, -7.0, 6.0))
+    scene = make_scene(sun(-30.0), cam1)
+    first = engine.render(scene, settings)
+    assert set(first.skipped) == set()  # a fresh engine runs everything
+    assert ALL_PASSES <= set(first.timings)
+    check_direct(first.passes, scene.lights[0], -30.0)
+
+    # Same scene (rebuilt, equal content): every pass is skipped, timings 0, the same passes come back.
+    second = engine.render(make_scene(sun(-30.0), cam1), settings)
+    assert set(second.skipped) == ALL_PASSES
+    assert all(second.timings[p] == 0.0 for p in ALL_PASSES)
+    for name, image in first.passes.items():
+        np.testing.assert_array_equal(second.passes[name], image)
+
+    # Move only the light: shadows and lighting re-run; geometry, textures and the G-buffer do not.
+    moved = make_scene(sun(-50.0), cam1)
+    third = engine.render(moved, settings)
+    assert set(third.skipped) == {"geometry", "textures", "gbuffer"}
+    assert {"shadow_maps", "direct_light", "compose"}.isdisjoint(third.skipped)
+    check_direct(third.passes, moved.lights[0], -50.0)
+    np.testing.assert_array_equal(third.passes["Position"], first.passes["Position"])
+
+    # Change only the camera: G-buffer, lighting and compose re-run; geometry, textures, shadow maps do not.
+    cam2 = camera((3.0, -6.0, 7.0))
+    turned = make_scene(sun(-50.0), cam2)
+    fourth = engine.render(turned, settings)
+    assert set(fourth.skipped) == {"geometry", "textures", "shadow_maps"}
+    assert not np.array_equal(fourth.passes["Position"], third.passes["Position"])
+    check_direct(fourth.passes, turned.lights[0], -50.0)
+
+    # Change only the world colour: just compose re-runs (the background of Combined changes).
+    world = make_scene(sun(-50.0), cam2)
+    world.world.color = (0.1, 0.2, 0.3)
+    fifth = engine.render(world, settings)
+    assert set(fifth.skipped) == ALL_PASSES - {"compose"}
