@@ -93,12 +93,43 @@ def load_scene(path: str, resolution=None):
     return scene
 
 
-def render_ours(scene, method: str):
+def parse_method_options(pairs) -> dict:
+    """`--lpv key=value ...` → LpvSettings keyword arguments, typed like the dataclass fields."""
+    import dataclasses
+
+    from ..gpu_kernels.lpv import LpvSettings
+
+    fields = {f.name: f for f in dataclasses.fields(LpvSettings)}
+    out = {}
+    for pair in pairs or ():
+        key, sep, value = pair.partition("=")
+        if not sep or key not in fields:
+            raise CliError(f"--lpv {pair}: expected KEY=VALUE with KEY one of {', '.join(fields)}")
+        default = getattr(LpvSettings(), key)
+        try:
+            if isinstance(default, bool):
+                if value.lower() not in ("1", "0", "true", "false", "yes", "no", "on", "off"):
+                    raise ValueError(value)
+                out[key] = value.lower() in ("1", "true", "yes", "on")
+            else:
+                out[key] = type(default)(value)
+        except ValueError:
+            raise CliError(f"--lpv {pair}: {value!r} is not a valid {type(default).__name__}") from None
+    return out
+
+
+def render_ours(scene, method: str, lpv_options: dict | None = None):
     from ..gpu_kernels.engine import get_engine
     from ..gpu_kernels.gpu_context import GpuUnavailableError
+    from ..gpu_kernels.lpv import LpvSettings
     from ..gpu_kernels.pipeline import RenderSettings, SceneError
 
-    settings = RenderSettings(method=method, width=scene.resolution[0], height=scene.resolution[1])
+    try:
+        lpv_settings = LpvSettings(**(lpv_options or {}))
+    except ValueError as exc:
+        raise CliError(f"--lpv: {exc}") from None
+    settings = RenderSettings(method=method, width=scene.resolution[0], height=scene.resolution[1],
+                              lpv=lpv_settings)
     try:
         return get_engine().render(scene, settings)
     except (SceneError, NotImplementedError, GpuUnavailableError) as exc:
@@ -112,12 +143,13 @@ def cmd_render(args) -> dict:
         check_blend_path(args.scene)
         out = check_output_path(os.path.splitext(os.path.abspath(args.scene))[0] + f"_bounce_{args.method}.exr", ".exr")
     scene = load_scene(args.scene, tuple(args.res) if args.res else None)
-    result = render_ours(scene, args.method)
+    result = render_ours(scene, args.method, parse_method_options(args.lpv))
     from ..gpu_kernels import exr_io
 
     write_output(exr_io.write_passes, out, result.passes)
     report = {"method": result.method, "resolution": list(result.resolution),
               "seconds": {k: round(v, 6) for k, v in result.timings.items()}, "skipped": result.skipped,
+              "info": result.info,
               "scene": result.statistics, "warnings": result.warnings, "output": out}
     if not args.json:
         print(format_timings(result.timings))
@@ -136,14 +168,14 @@ def format_timings(timings: dict) -> str:
     return "\n".join(lines)
 
 
-def compare(scene, method: str, samples: int, bounces: int = 8, progress=_progress) -> dict:
+def compare(scene, method: str, samples: int, bounces: int = 8, progress=_progress, lpv_options=None) -> dict:
     """Render ours and the (cached) two-seed Cycles reference of the currently open scene; return the errors."""
     import numpy as np
 
     from ..gpu_kernels import metrics
     from .cycles_reference import ReferenceSettings, render_reference
 
-    result = render_ours(scene, method)
+    result = render_ours(scene, method, lpv_options)
     ref_settings = ReferenceSettings(scene.resolution[0], scene.resolution[1], samples=samples, bounces=bounces)
     ref = render_reference(scene.content_hash(), ref_settings, progress=progress)
     ours = result.passes
@@ -168,6 +200,7 @@ def compare(scene, method: str, samples: int, bounces: int = 8, progress=_progre
                                         "does not render world light"] if max(scene.world.color) > 0 and
                                        method == "none" else []),
         "pixels_compared": int(mask.sum()),
+        "info": result.info,
     }
     return report, result, ref, mask
 
@@ -175,7 +208,8 @@ def compare(scene, method: str, samples: int, bounces: int = 8, progress=_progre
 def cmd_compare(args) -> dict:
     heatmap = check_output_path(args.heatmap, ".png") if args.heatmap else None
     scene = load_scene(args.scene, tuple(args.res) if args.res else None)
-    report, result, ref, mask = compare(scene, args.method, args.samples, args.bounces)
+    report, result, ref, mask = compare(scene, args.method, args.samples, args.bounces,
+                                        lpv_options=parse_method_options(args.lpv))
     if heatmap:
         from ..gpu_kernels import exr_io, metrics
 
@@ -219,6 +253,7 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--res", nargs=2, type=int, metavar=("W", "H"))
     r.add_argument("--out", help="output .exr (default: next to the .blend)")
     r.add_argument("--json", action="store_true", help="print one JSON object as the last stdout line")
+    r.add_argument("--lpv", nargs="+", metavar="KEY=VALUE", help="LPV settings, e.g. bounces=4 resolution=32")
     r.set_defaults(func=cmd_render)
     c = sub.add_parser("compare", help="render and compare with a two-seed Cycles reference (cached)")
     c.add_argument("scene")
@@ -228,6 +263,7 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--res", nargs=2, type=int, metavar=("W", "H"))
     c.add_argument("--json", action="store_true")
     c.add_argument("--heatmap", help="write a per-pixel relative error heat map (PNG)")
+    c.add_argument("--lpv", nargs="+", metavar="KEY=VALUE", help="LPV settings, e.g. bounces=4 resolution=32")
     c.set_defaults(func=cmd_compare)
     return parser
 

@@ -78,6 +78,7 @@ class ShadowAtlas:
     light_count: int
     view_count: int
     warnings: list
+    buffers: lb.LightBuffers  # the CPU-side records (RSMs reuse the views)
 
     def release(self):
         for obj in (self.depth, self.light_ssbo, self.view_ssbo, self.polygon_ssbo):
@@ -113,12 +114,12 @@ def render_shadow_atlas(ctx, programs, scene: Scene, geometry: GeometryBuffers,
             prog["u_far"].value = float(view.far)
             geometry.vao_depth.render(moderngl.TRIANGLES)
         fbo.release()
-    views = lb.pack_views(buffers.views, tiles, size, settings.pcf_radius)
-    return ShadowAtlas(depth, size, _ssbo(ctx, buffers.lights), _ssbo(ctx, views), _ssbo(ctx, buffers.polygon_vertices),
-                       len(buffers.lights), len(buffers.views), warnings)
+    views = lb.pack_views(buffers.views, tiles, size, settings.pcf_radius, buffers.view_lights)
+    return ShadowAtlas(depth, size, ssbo(ctx, buffers.lights), ssbo(ctx, views), ssbo(ctx, buffers.polygon_vertices),
+                       len(buffers.lights), len(buffers.views), warnings, buffers)
 
 
-def _ssbo(ctx, array: np.ndarray):
+def ssbo(ctx, array: np.ndarray):
     data = np.ascontiguousarray(array).tobytes()
     return ctx.buffer(data if data else b"\0" * 16)
 
@@ -163,6 +164,15 @@ def render_gbuffer(ctx, programs, scene: Scene, geometry: GeometryBuffers, textu
     _set(prog, "u_camera_position", tuple(cam_world[:3, 3]))
     _set(prog, "u_camera_forward", tuple(forward))
     _set(prog, "u_camera_ortho", camera.type == "ORTHO")
+    draw_by_material(prog, scene, geometry, textures)
+    return GBuffer(targets, depth, fbo, (width, height))
+
+
+def draw_by_material(prog, scene: Scene, geometry: GeometryBuffers, textures: list, vao=None) -> None:
+    """Draw the geometry one material range at a time with that material's uniforms (materials_common.glsl)."""
+    import moderngl
+
+    vao = vao or geometry.vao_full
     for mat_index, first, count in geometry.ranges:
         mat = scene.materials[mat_index] if 0 <= mat_index < len(scene.materials) else None
         base = mat.base_color if mat else (0.8, 0.8, 0.8)
@@ -176,8 +186,7 @@ def render_gbuffer(ctx, programs, scene: Scene, geometry: GeometryBuffers, textu
         if use_tex:
             textures[mat.base_color_texture].use(location=0)
             _set(prog, "u_base_texture", 0)
-        geometry.vao_full.render(moderngl.TRIANGLES, vertices=count, first=first)
-    return GBuffer(targets, depth, fbo, (width, height))
+        vao.render(moderngl.TRIANGLES, vertices=count, first=first)
 
 
 def _set(prog, name, value):

@@ -52,6 +52,8 @@ class ShadowView:
     texel_world: float  # world size of one texel at unit distance (perspective) or absolute (ortho)
     resolution: int
     far: float = 0.0  # perspective: depth is stored as distance / far; 0 for orthographic
+    view_matrix: np.ndarray | None = None  # world → view (rows: right, up, −forward)
+    half_extent: float = 0.0  # tan(half fov) (perspective) or half width in metres (orthographic)
 
 
 @dataclass
@@ -60,6 +62,7 @@ class LightBuffers:
     views: list  # ShadowView, in the order lights refer to them
     polygon_vertices: np.ndarray  # (V, 4) float32
     warnings: list
+    view_lights: list = None  # index of the light record each view belongs to
 
 
 def _color(light: Light) -> np.ndarray:
@@ -140,7 +143,7 @@ def cube_views(origin, resolution: int, near: float, far: float) -> list[ShadowV
     for fwd, up in CUBE_DIRECTIONS:
         view = cam.look_at(origin, np.asarray(origin) + fwd, up)
         views.append(ShadowView(proj @ view, np.asarray(origin, np.float64), False,
-                                2 * margin / resolution, resolution, far))
+                                2 * margin / resolution, resolution, far, view, margin))
     return views
 
 
@@ -153,7 +156,7 @@ def sun_view(scene: Scene, light: Light, resolution: int) -> ShadowView:
     view = cam.look_at(eye, centre, up)
     r = radius * 1.02
     proj = cam.ortho(-r, r, -r, r, radius * 0.5, radius * 3.5)
-    return ShadowView(proj @ view, eye, True, 2 * r / resolution, resolution)
+    return ShadowView(proj @ view, eye, True, 2 * r / resolution, resolution, 0.0, view, r)
 
 
 def spot_view(scene: Scene, light: Light, resolution: int, near: float, far: float) -> ShadowView:
@@ -163,7 +166,7 @@ def spot_view(scene: Scene, light: Light, resolution: int, near: float, far: flo
     up = np.array([0, 0, 1.0]) if abs(d[2]) < 0.99 else np.array([0, 1.0, 0])
     view = cam.look_at(pos, pos + d, up)
     return ShadowView(cam.perspective(fov, 1.0, near, far) @ view, pos, False,
-                      2 * math.tan(fov / 2) / resolution, resolution, far)
+                      2 * math.tan(fov / 2) / resolution, resolution, far, view, math.tan(fov / 2))
 
 
 def _near_far(scene: Scene, origin) -> tuple[float, float]:
@@ -191,7 +194,7 @@ def emissive_triangles(scene: Scene) -> tuple[np.ndarray, np.ndarray]:
 def build_light_buffers(scene: Scene, settings: ShadowSettings | None = None) -> LightBuffers:
     """Pack every light (and emissive triangle) into GPU records and list the shadow views they sample."""
     s = settings or ShadowSettings()
-    records, views, polys, warnings = [], [], [], []
+    records, views, polys, warnings, view_lights = [], [], [], [], []
 
     def add(type_, color, position=(0, 0, 0), radius=0.0, direction=(0, 0, -1), cos_half=0.0, smooth=0.0,
             light_views=(), samples=0, per=0, poly=None, two_sided=False):
@@ -204,6 +207,7 @@ def build_light_buffers(scene: Scene, settings: ShadowSettings | None = None) ->
             rec["polygon"] = (sum(len(p) for p in polys), len(poly), 1.0 if two_sided else 0.0, 0)
             polys.append(np.asarray(poly, np.float64))
         views.extend(light_views)
+        view_lights.extend([len(records)] * len(light_views))
         records.append(rec)
 
     for light in scene.lights:
@@ -268,11 +272,12 @@ def build_light_buffers(scene: Scene, settings: ShadowSettings | None = None) ->
     lights = np.array(records, LIGHT_DTYPE) if records else np.zeros(0, LIGHT_DTYPE)
     vertices = np.concatenate(polys) if polys else np.zeros((0, 3))
     vertices = np.concatenate([vertices, np.ones((len(vertices), 1))], axis=1).astype(np.float32)
-    return LightBuffers(lights, views, vertices, warnings)
+    return LightBuffers(lights, views, vertices, warnings, view_lights)
 
 
-def pack_views(views: list[ShadowView], tiles: list[tuple], atlas_size: tuple[int, int], pcf_radius: int) -> np.ndarray:
-    """ShadowView list + atlas tiles (x, y, w, h in texels) → VIEW_DTYPE records."""
+def pack_views(views: list[ShadowView], tiles: list[tuple], atlas_size: tuple[int, int], pcf_radius: int,
+               view_lights: list | None = None) -> np.ndarray:
+    """ShadowView list + atlas tiles (x, y, w, h in texels) → VIEW_DTYPE records (info.w = the view's light)."""
     out = np.zeros(len(views), VIEW_DTYPE)
     aw, ah = atlas_size
     for i, (v, (x, y, w, h)) in enumerate(zip(views, tiles)):
@@ -281,7 +286,8 @@ def pack_views(views: list[ShadowView], tiles: list[tuple], atlas_size: tuple[in
         out[i]["tile"] = (x / aw, y / ah, w / aw, h / ah)
         out[i]["origin"] = (*v.origin, 1.0 if v.ortho else 0.0)
         # The atlas may have shrunk the tile: a texel then covers resolution/w times more ground.
-        out[i]["info"] = (v.texel_world * v.resolution / w, pcf_radius, v.far, 0)
+        light = view_lights[i] if view_lights is not None else 0
+        out[i]["info"] = (v.texel_world * v.resolution / w, pcf_radius, v.far, light)
     return out
 
 

@@ -15,11 +15,13 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from . import direct
+from . import direct, lpv, vct
 from .light_buffers import ShadowSettings
+from .lpv import LpvSettings
 from .pass_cache import PassCache
 from .programs import ProgramCache
 from .scene import Scene, _hash_into
+from .vct import VctSettings
 
 METHODS = ("none", "lpv", "vct")
 PASS_NAMES = ("Combined", "Diffuse Direct", "Diffuse Indirect", "Diffuse Color", "Emission", "Normal", "Position",
@@ -37,6 +39,8 @@ class RenderSettings:
     width: int = 640
     height: int = 480
     shadow: ShadowSettings = field(default_factory=ShadowSettings)
+    lpv: LpvSettings = field(default_factory=LpvSettings)
+    vct: VctSettings = field(default_factory=VctSettings)
 
     def key(self) -> str:
         return repr(sorted(asdict(self).items()))
@@ -51,6 +55,7 @@ class RenderResult:
     statistics: dict
     method: str
     resolution: tuple
+    info: dict = field(default_factory=dict)  # method details: LPV iterations, injected flux, grids
 
 
 def _hash(*parts) -> str:
@@ -63,8 +68,6 @@ def _hash(*parts) -> str:
 def check_renderable(scene: Scene, settings: RenderSettings) -> None:
     if settings.method not in METHODS:
         raise SceneError(f"unknown method '{settings.method}' (choose from {', '.join(METHODS)})")
-    if settings.method != "none":
-        raise NotImplementedError(f"method '{settings.method}' is not implemented yet; use --method none")
     if scene.camera is None:
         raise SceneError("the scene has no camera")
     if settings.width < 1 or settings.height < 1 or settings.width > 16384 or settings.height > 16384:
@@ -103,14 +106,66 @@ class Pipeline:
         k_direct = (k_gbuffer, k_shadow)
         direct_tex = cache.run("direct_light", k_direct,
                                lambda: direct.render_direct_light(ctx, programs, gbuffer, shadows))
-        passes = cache.run("compose", (k_direct, k_world),
-                           lambda: compose_passes(gbuffer, direct_tex, scene.world.color))
+        indirect_tex, k_indirect, info = None, None, {}
+        if settings.method == "lpv":
+            indirect_tex, k_indirect, info = self._lpv(scene, settings, geometry, textures, shadows, gbuffer,
+                                                       k_geometry, k_materials, k_shadow, k_gbuffer)
+        elif settings.method == "vct":
+            indirect_tex, k_indirect, info = self._vct(scene, settings, geometry, textures, shadows, gbuffer,
+                                                       k_geometry, k_materials, k_shadow, k_gbuffer)
+        passes = cache.run("compose", (k_direct, k_indirect, k_world), lambda: compose_passes(
+            gbuffer, direct_tex, scene.world.color,
+            None if indirect_tex is None else direct.read_texture(indirect_tex, 3)))
         timings = dict(cache.timings)
         timings["total"] = time.perf_counter() - start
         return RenderResult(passes=passes, timings=timings, skipped=list(cache.skipped),
                             warnings=list(scene.warnings) + list(shadows.warnings),
                             statistics=scene.statistics(), method=settings.method,
-                            resolution=(settings.width, settings.height))
+                            resolution=(settings.width, settings.height), info=info)
+
+    def _lpv(self, scene, settings, geometry, textures, shadows, gbuffer, k_geometry, k_materials, k_shadow,
+             k_gbuffer):
+        """LPV passes: rsm ← shadow views; lpv_inject ← rsm, grids; geometry_volume ← geometry, grids;
+        lpv_propagate ← injection, geometry volume, LPV settings; lpv_lighting ← gbuffer, propagation."""
+        ctx, programs, cache, s = self.ctx, self.programs, self.cache, settings.lpv
+        grids = lpv.cascade_grids(scene, s)
+        k_grids = tuple(g.key() for g in grids)
+        k_rsm = (k_shadow, s.rsm_resolution)
+        rsm = cache.run("rsm", k_rsm, lambda: lpv.render_rsm(ctx, programs, scene, geometry, textures, shadows,
+                                                             s.rsm_resolution))
+        k_inject = (k_rsm, k_grids)
+        states = cache.run("lpv_inject", k_inject, lambda: lpv.inject_all(ctx, programs, rsm, shadows, grids))
+        k_gv = (k_geometry, k_materials, k_grids, s.occlusion)
+        gvs = cache.run("geometry_volume", k_gv, lambda: lpv.geometry_volumes(
+            ctx, programs, scene, geometry, textures, grids) if s.occlusion else [None] * len(grids))
+        k_prop = (k_inject, k_gv, repr(s))
+        stats = cache.run("lpv_propagate", k_prop, lambda: lpv.propagate_all(ctx, programs, states, gvs, s))
+        k_light = (k_gbuffer, k_prop)
+        indirect = cache.run("lpv_lighting", k_light, lambda: lpv.lighting(ctx, programs, gbuffer, states, gvs, s))
+        return indirect, k_light, stats
+
+    def _vct(self, scene, settings, geometry, textures, shadows, gbuffer, k_geometry, k_materials, k_shadow,
+             k_gbuffer):
+        """VCT passes (seed 004): vct_voxelize ← geometry, materials, grid; vct_inject ← voxels, shadow maps (lights);
+        vct_mipmap ← injection, anisotropy; vct_bounce ← mipmaps, world, cone settings, bounces;
+        vct_trace ← gbuffer, bounced volumes, cone settings."""
+        ctx, programs, cache, s = self.ctx, self.programs, self.cache, settings.vct
+        grid = vct.vct_grid(scene, s)
+        levels = vct.mip_levels(s.resolution)
+        world = tuple(float(c) for c in scene.world.color[:3])
+        k_vox = (k_geometry, k_materials, grid.key())
+        vox = cache.run("vct_voxelize", k_vox,
+                        lambda: vct.voxelize_scene(ctx, programs, scene, geometry, textures, grid))
+        k_inject = (k_vox, k_shadow, levels)
+        faces = cache.run("vct_inject", k_inject, lambda: vct.inject(ctx, programs, vox, shadows, levels))
+        k_mip = (k_inject, s.anisotropic)
+        volumes = cache.run("vct_mipmap", k_mip, lambda: vct.build_volumes(ctx, programs, faces, s.anisotropic))
+        k_bounce = (k_mip, world, s.key("bounce"))
+        bounced = cache.run("vct_bounce", k_bounce,
+                            lambda: vct.bounce(ctx, programs, vox, faces, volumes, s, world))
+        k_trace = (k_gbuffer, k_bounce, s.key("trace"))
+        traced = cache.run("vct_trace", k_trace, lambda: vct.trace(ctx, programs, gbuffer, bounced, s, world))
+        return traced["indirect"], k_trace, vct.render_info(faces, bounced, s)
 
     def release(self) -> None:
         self.cache.clear()

@@ -175,17 +175,6 @@ def test_out_to_read_only_directory(env, blends, tmp_path):
         assert os.listdir(ro) == []
 
 
-@pytest.mark.parametrize("method", ["lpv", "vct"])
-def test_unimplemented_method(env, blends, tmp_path, method):
-    out = tmp_path / "o.exr"
-    before = snapshot(blends, tmp_path)
-    proc = run(env, "render", blends / "cornell.blend", "--res", 16, 12, "--method", method, "--out", out)
-    if proc.returncode == 0:
-        pytest.skip(f"method '{method}' is implemented now; this check is obsolete")
-    assert_bad_input(proc, method, "not implemented yet")
-    assert not out.exists() and snapshot(blends, tmp_path) == before
-
-
 def test_argparse_errors_exit_2_without_traceback(env, blends):
     for args in (["render", blends / "cornell.blend", "--method", "bogus"], ["render"], ["frobnicate"],
                  ["render", blends / "cornell.blend", "--res", "ten", "10"]):

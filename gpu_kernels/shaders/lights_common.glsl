@@ -20,7 +20,7 @@ struct ShadowView {
     mat4 view_projection;
     vec4 tile;            // atlas uv rectangle: xy origin, zw size
     vec4 origin;          // xyz: eye position (perspective) ; w: 1 if orthographic
-    vec4 info;            // x: texel world size at unit distance (perspective) or absolute (ortho); y: PCF radius in texels;
+    vec4 info;            // x: texel world size at unit distance (perspective) or absolute (ortho); y: PCF radius in texels; w: index of its light;
                           // z: far distance (perspective: stored depth = distance / far)
 };
 

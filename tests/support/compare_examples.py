@@ -1,7 +1,7 @@
 """Render example scenes with Bounce GI and with Cycles (two seeds) and print one JSON line of errors.
 
 Run in a subprocess by tests/test_direct_vs_cycles.py so bpy's global state stays out of the pytest process:
-    python tests/support/compare_examples.py SAMPLES NAME [NAME...]
+    python tests/support/compare_examples.py SAMPLES NAME [NAME...] [--method lpv] [--lpv KEY=VALUE ...]
 """
 import json
 import os
@@ -17,12 +17,22 @@ from examples import scenes  # noqa: E402
 def main():
     import bpy
 
-    samples = int(sys.argv[1])
+    import argparse
+
+    from bounce_gi.addon.cli import parse_method_options
+
+    parser = argparse.ArgumentParser()
+    parser.add_argument("samples", type=int)
+    parser.add_argument("names", nargs="+")
+    parser.add_argument("--method", default="none")
+    parser.add_argument("--lpv", nargs="+", default=[])
+    args = parser.parse_args()
     out = {}
-    for name in sys.argv[2:]:
+    for name in args.names:
         scenes.build(name)
         scene = extract_scene(bpy.context.evaluated_depsgraph_get())
-        report, *_ = compare(scene, "none", samples, progress=lambda m: None)
+        report, *_ = compare(scene, args.method, args.samples, progress=lambda m: None,
+                             lpv_options=parse_method_options(args.lpv))
         out[name] = report
     sys.stdout.flush()
     print("RESULT " + json.dumps(out), flush=True)

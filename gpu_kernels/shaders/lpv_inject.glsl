@@ -1,0 +1,106 @@
+// LPV injection (seed 000 §3.3, seed 001): every RSM texel is a VPL of flux Φ = albedo × (irradiance × texel area);
+// its intensity (Φ/π)·max(0, n·ω) is projected on 2-band SH and added to the cell half a cell in front of it.
+// Accumulation is exact fixed point (integer atomics; no float atomics here), scaled by u_fixed_scale.
+// Because Φ carries the texel's world area, the result does not depend on the RSM resolution.
+#include "lights_common.glsl"
+#include "light_eval.glsl"
+#include "lpv_common.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+uniform sampler2D u_rsm_position;
+uniform sampler2D u_rsm_normal;
+uniform sampler2D u_rsm_albedo;
+uniform ivec2 u_rsm_size;
+uniform int u_rsm_resolution;     // texels per RSM view side
+uniform vec3 u_grid_origin;
+uniform float u_grid_cell;
+uniform ivec3 u_grid_size;
+uniform float u_fixed_scale;
+
+struct RsmView {
+    vec4 params;   // x: tan(half fov) (perspective) or 0; y: texel world size (orthographic); z: light; w: sample k
+    vec4 origin;   // xyz eye (perspective); w: 1 if orthographic
+    vec4 axis;     // xyz view axis; w: unused
+    vec4 right;    // xyz right vector of the view; w: unused (with axis and up: tangent-plane coordinates)
+};
+layout(std430, binding = 3) readonly buffer RsmViewBuffer { RsmView rsm_views[]; };
+layout(std430, binding = 4) buffer LpvAccum { int accum[]; };  // 12 ints per cell: RGB × 4 SH coefficients
+
+// Solid angle of one texel of a perspective view with tan(half fov) m at tangent-plane point (x, y):
+// (2m/res)² / (1 + x² + y²)^(3/2).
+float texel_solid_angle(RsmView v, vec3 p) {
+    vec3 d = p - v.origin.xyz;
+    float z = dot(d, v.axis.xyz);
+    vec3 up = cross(v.right.xyz, v.axis.xyz);
+    float x = dot(d, v.right.xyz) / z, y = dot(d, up) / z;
+    float t = 2.0 * v.params.x / float(u_rsm_resolution);
+    return t * t / pow(1.0 + x * x + y * y, 1.5);
+}
+
+// Reflected flux of a surfel at p (normal n facing the light, albedo a) seen by RSM view v.
+vec3 vpl_flux(RsmView v, vec3 p, vec3 n, vec3 albedo) {
+    GpuLight L = lights[int(v.params.z)];
+    int type = int(L.color_type.w);
+    vec3 color = L.color_type.rgb;
+    if (type == LIGHT_SUN) {
+        // E·A = S·cosθ · t²/cosθ: the sun's flux through one texel of the orthographic map.
+        float cosine = dot(n, -L.direction.xyz);
+        return cosine > 0.0 ? albedo * color * v.params.y * v.params.y : vec3(0.0);
+    }
+    if (type == LIGHT_POINT || type == LIGHT_SPOT) {
+        // E·A = I·cosθ/(d²+r²) · d²Ω/cosθ = I·Ω·d²/(d²+r²): the light's flux into the texel's solid angle.
+        vec3 d = p - L.position.xyz;
+        float d2 = dot(d, d);
+        float att = type == LIGHT_SPOT ? spot_attenuation(L, normalize(d)) : 1.0;
+        return albedo * color * att * texel_solid_angle(v, p) * d2 / (d2 + L.position.w);
+    }
+    // Polygon light seen from sample point k: this RSM carries the share w_k/Σw_j of the exact irradiance, where
+    // w_j = cosθ_light,j · cosθ_surface,j / d_j² (the same weights as the shadow test). E_k·A simplifies to
+    // E · cosθ_light,k · Ω / Σw_j, with no division by the grazing cosine.
+    float psa = polygon_projected_solid_angle(int(L.polygon.x), int(L.polygon.y), p, n);
+    if (psa <= 0.0) return vec3(0.0);
+    int first = int(L.params.y), per = int(L.params.w), samples = int(L.params.z);
+    bool two_sided = L.polygon.z > 0.5;
+    float wsum = 0.0, cos_k = 0.0;
+    int k = int(v.params.w);
+    for (int j = 0; j < samples; ++j) {
+        vec3 o = shadow_views[first + j * per].origin.xyz;
+        vec3 d = p - o;
+        float d2 = max(dot(d, d), 1e-8);
+        vec3 w = d * inversesqrt(d2);
+        vec3 side_n = (two_sided && (j % 2 == 1)) ? -L.direction.xyz : L.direction.xyz;
+        float cl = max(dot(side_n, w), 0.0);
+        wsum += cl * max(dot(n, -w), 0.0) / d2;
+        if (j == k) cos_k = cl;
+    }
+    if (wsum <= 0.0) return vec3(0.0);
+    return albedo * color * psa * cos_k * texel_solid_angle(v, p) / wsum;
+}
+
+void add_fixed(int base, vec4 c) {
+    atomicAdd(accum[base + 0], int(round(c.x * u_fixed_scale)));
+    atomicAdd(accum[base + 1], int(round(c.y * u_fixed_scale)));
+    atomicAdd(accum[base + 2], int(round(c.z * u_fixed_scale)));
+    atomicAdd(accum[base + 3], int(round(c.w * u_fixed_scale)));
+}
+
+void main() {
+    ivec2 px = ivec2(gl_GlobalInvocationID.xy);
+    if (any(greaterThanEqual(px, u_rsm_size))) return;
+    vec4 pos = texelFetch(u_rsm_position, px, 0);
+    if (pos.w < 0.5) return;
+    RsmView v = rsm_views[int(pos.w - 0.5)];
+    vec3 n = normalize(texelFetch(u_rsm_normal, px, 0).xyz);
+    vec3 albedo = texelFetch(u_rsm_albedo, px, 0).rgb;
+    vec3 flux = vpl_flux(v, pos.xyz, n, albedo);
+    if (max(flux.r, max(flux.g, flux.b)) <= 0.0) return;
+    LpvGrid g = LpvGrid(u_grid_origin, u_grid_cell, u_grid_size);
+    // Half a cell along the normal: the VPL lands in the cell in front of its surface (seed 000 §3.3).
+    ivec3 c = lpv_cell(g, pos.xyz + n * 0.5 * g.cell);
+    if (!lpv_inside(g, c)) return;
+    vec4 lobe = sh_clamped_cosine(n) / PI;
+    int base = lpv_index(g, c) * 12;
+    add_fixed(base + 0, lobe * flux.r);
+    add_fixed(base + 4, lobe * flux.g);
+    add_fixed(base + 8, lobe * flux.b);
+}

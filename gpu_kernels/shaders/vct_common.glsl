@@ -1,0 +1,135 @@
+// Voxel cone tracing (seed 004 §3.4, §4.5.2; Crassin et al. 2011): the grid, the cone table, one cone step through
+// the filtered radiance volumes, and the cosine-weighted hemisphere gather shared by the per-voxel bounce pass
+// (vct_bounce.glsl) and the per-pixel trace (vct_trace.glsl). vct.py documents every constant.
+//
+// Volumes hold optical depth τ and τ-weighted radiance (rgb = τ·S, a = τ), see vct_mipmap.glsl.
+// MODE_ANISO: six volumes, one per direction of travel (+x, −x, +y, −y, +z, −z), each holding what a ray
+// travelling that way sees (vct_mipmap.glsl). Otherwise one isotropic volume.
+#pragma once
+
+#define MAX_CONES 9
+#define MAX_STEPS 1024
+#define MIN_TRANSMITTANCE 1e-3   // stop a cone when < 0.1% of it is left: the error is below 0.1% of its radiance
+
+uniform vec3 u_grid_origin;      // world position of the grid's min corner
+uniform float u_cell;            // voxel edge (m)
+uniform ivec3 u_grid_size;       // voxels per axis at level 0 (a multiple of 2^u_max_lod, so levels nest exactly)
+uniform float u_max_lod;         // coarsest mip level
+uniform int u_cone_count;
+uniform vec4 u_cones[MAX_CONES]; // xyz: unit direction in the normal's frame (z = normal); w: weight ∫region cosθ dω
+uniform float u_cone_tan[MAX_CONES];   // tan(half-angle)
+uniform float u_step;            // step length / sampled voxel size (seed 004 listing 4.1 steps by the radius: 0.5)
+uniform float u_offset;          // start offset along the geometric normal, in voxels (scaled by ‖n‖₁, see below)
+uniform float u_max_distance;    // metres; 0 = until the cone leaves the grid
+uniform float u_ao_distance;     // metres; 0 = AO is the sky visibility (transmittance of cones leaving the grid)
+uniform vec3 u_world;            // world (background) radiance, seen through what is left of a cone leaving the grid
+
+#if defined(MODE_ANISO)
+uniform sampler3D u_volume[6];
+#else
+uniform sampler3D u_volume[1];
+#endif
+
+const float VCT_PI = 3.14159265358979;
+
+// Premultiplied radiance and opacity of one step of k texels of the sampled level along unit direction d, from
+// volumes storing (τ·S, τ) (vct_mipmap.glsl): α' = 1 − e^(−k·τ), the step-length correction of the seed's
+// α' = 1 − (1 − α)^k written in optical depth; radiance S = τ·S / τ, the τ-weighted mean of the filtered texels.
+// Anisotropic: τ_i of the volume for the sign of d_i is the optical depth of crossing one texel along axis i. A
+// planar layer with normal along i is crossed once by a ray at any angle, so its optical depth per unit length
+// along d is |d_i|·τ_i; summed over the axes this is exact for axis-aligned layers (Crassin's d² weights would let
+// a layer leak at grazing angles). S is the τ-weighted mean of the three volumes.
+vec4 cone_step(vec3 uvw, float lod, vec3 d, float k) {
+#if defined(MODE_ANISO)
+    vec4 sx = d.x >= 0.0 ? textureLod(u_volume[0], uvw, lod) : textureLod(u_volume[1], uvw, lod);
+    vec4 sy = d.y >= 0.0 ? textureLod(u_volume[2], uvw, lod) : textureLod(u_volume[3], uvw, lod);
+    vec4 sz = d.z >= 0.0 ? textureLod(u_volume[4], uvw, lod) : textureLod(u_volume[5], uvw, lod);
+    vec3 w = abs(d);
+    float tau = w.x * sx.a + w.y * sy.a + w.z * sz.a;
+    if (tau <= 1e-9) return vec4(0.0);
+    vec3 radiance = (w.x * sx.rgb + w.y * sy.rgb + w.z * sz.rgb) / tau;
+#else
+    vec4 s = textureLod(u_volume[0], uvw, lod);
+    float tau = s.a;
+    if (tau <= 1e-9) return vec4(0.0);
+    vec3 radiance = s.rgb / tau;
+#endif
+    float alpha = 1.0 - exp(-k * tau);
+    return vec4(alpha * radiance, alpha);
+}
+
+struct ConeResult {
+    vec3 radiance;        // radiance gathered along the cone (premultiplied by what was left of it)
+    float transmittance;  // what is left of the cone where it stopped
+    bool exited;          // it left the grid (the world shows through the rest)
+    float ao;             // transmittance at u_ao_distance, or the sky visibility when that is 0
+};
+
+// March one cone from surface point p (geometric normal n_geo, unit) along unit d with tan(half-angle) tan_half.
+//
+// Self-occlusion (derived, not tuned): trilinear filtering at level l reads texels whose centres lie within one
+// texel V = cell·2^l of the sample on every axis, and the texel holding p has its centre at most V/2·‖n‖₁ above p's
+// tangent plane, so a sample at height h above that plane reads none of p's own texels iff h ≥ 1.5·V·‖n‖₁. Hence
+// the start offset of 1.5 voxels (× ‖n‖₁) along the normal, and the level is capped at
+// floor(log2(h / (1.5·‖n‖₁·cell))): grazing cones sample finer levels (more, shorter steps) rather than the surface
+// they start from. The level otherwise follows the cone diameter (seed 004 listing 4.1: lod = log2(diameter)).
+ConeResult trace_cone(vec3 p, vec3 n_geo, vec3 d, float tan_half) {
+    float n1 = abs(n_geo.x) + abs(n_geo.y) + abs(n_geo.z);
+    float h0 = u_offset * n1 * u_cell;
+    vec3 o = p + n_geo * h0;
+    float dh = dot(d, n_geo);
+    float ao_limit = u_ao_distance > 0.0 ? u_ao_distance : 3.4e38;
+    ConeResult r = ConeResult(vec3(0.0), 1.0, false, 1.0);
+    bool ao_set = false;
+    float t = 0.0;
+    vec3 inv_size = 1.0 / vec3(u_grid_size);
+    for (int i = 0; i < MAX_STEPS; ++i) {
+        vec3 g = (o + d * t - u_grid_origin) / u_cell;
+        if (any(lessThan(g, vec3(0.0))) || any(greaterThan(g, vec3(u_grid_size)))) {
+            r.exited = true;
+            break;
+        }
+        if ((u_max_distance > 0.0 && t > u_max_distance)) break;
+        if (!ao_set && t >= ao_limit) {
+            r.ao = r.transmittance;
+            ao_set = true;
+        }
+        float lod = log2(max(2.0 * t * tan_half, u_cell) / u_cell);
+        float h = h0 + t * dh;
+        float cap = floor(log2(max(h / (1.5 * n1 * u_cell), 1.0)));
+        lod = min(min(lod, cap), u_max_lod);
+        vec4 s = cone_step(g * inv_size, lod, d, u_step);
+        r.radiance += r.transmittance * s.rgb;
+        r.transmittance *= 1.0 - s.a;
+        if (r.transmittance < MIN_TRANSMITTANCE) break;
+        t += u_step * u_cell * exp2(lod);
+    }
+    if (!ao_set) r.ao = u_ao_distance > 0.0 ? r.transmittance : (r.exited ? r.transmittance : 0.0);
+    return r;
+}
+
+// Orthonormal basis around unit n (Duff et al. 2017, "Building an orthonormal basis, revisited").
+void onb(vec3 n, out vec3 t1, out vec3 t2) {
+    float s = n.z >= 0.0 ? 1.0 : -1.0;
+    float a = -1.0 / (s + n.z);
+    float b = n.x * n.y * a;
+    t1 = vec3(1.0 + s * n.x * n.x * a, s * b, -s * n.x);
+    t2 = vec3(b, s + n.y * n.y * a, -n.y);
+}
+
+// Irradiance E at p over the hemisphere of n (rgb), and the cosine-weighted AO / sky visibility (a, in [0, 1]):
+// E = Σ_k w_k·(L_k + T_k·L_world if cone k left the grid), with Σ_k w_k = π (vct.cone_table).
+vec4 gather_irradiance(vec3 p, vec3 n, vec3 n_geo) {
+    vec3 t1, t2;
+    onb(n, t1, t2);
+    vec3 e = vec3(0.0);
+    float ao = 0.0;
+    for (int k = 0; k < u_cone_count; ++k) {
+        vec4 c = u_cones[k];
+        vec3 d = normalize(t1 * c.x + t2 * c.y + n * c.z);
+        ConeResult r = trace_cone(p, n_geo, d, u_cone_tan[k]);
+        e += c.w * (r.radiance + (r.exited ? r.transmittance * u_world : vec3(0.0)));
+        ao += c.w * r.ao;
+    }
+    return vec4(e, ao / VCT_PI);
+}

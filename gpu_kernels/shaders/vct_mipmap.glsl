@@ -1,0 +1,148 @@
+// VCT radiance filtering (seed 004 §4.4: "a compute shader kernel is launched for each level ... averaging the
+// surrounding 8 values"). Volumes store optical depth and τ-weighted radiance, rgb = τ·S, a = τ:
+//   τ = optical depth of crossing one texel of that level (along the volume's axis when anisotropic),
+//   S = the radiance it sends back toward the ray (W/(m²·sr)).
+// Why τ and not the usual opacity α = 1 − e^−τ: trilinear filtering and the cone's discrete steps then integrate
+// τ exactly — a hat-shaped τ profile sampled every half texel sums to the texel's τ for any phase — so a wall one
+// voxel thick stops exactly as much of a cone as it should, wherever the samples fall. Filtering α instead smears
+// an opaque wall into partially transparent samples whose product lets ~20% of a cone through (measured in the
+// white furnace: 12% of the light lost with α, see tests/test_vct.py). And τ·S interpolates to the τ-weighted mean
+// radiance, the source function of the filtered medium. An opaque voxel gets τ_max = −ln(MIN_TRANSMITTANCE): it
+// ends a cone, as an opaque voxel should (vct_common.glsl).
+//
+// MODE_BASE: level 0 from the six face radiances of vct_inject / vct_bounce (rgb = L_g, a = α_g, g = outward face
+//   normal +x, −x, +y, −y, +z, −z), τ = −ln(1 − α) capped at τ_max.
+//   isotropic: α = max_g α_g (= the voxelizer's opacity), S = the brightest face, per channel. One value must serve
+//     every direction; the brightest face keeps a wall lit on one side as bright as it is (the mean would halve it,
+//     since most walls are dark on their back), at the price of the classic VCT leak: the back side glows too.
+//   MODE_ANISO: volume f (direction of travel +x, −x, ...) holds the face a ray travelling that way sees, i.e. the
+//     face whose normal points back at it: g = f ^ 1 (Crassin et al. 2011's directional voxels, down to level 0).
+// MODE_DOWN: level l from level l − 1 (sizes are multiples of 2^max_level, so every parent has 8 children).
+//   isotropic: the mean extinction coefficient σ = τ/V of the 8 children, so τ_parent = 2·mean τ (the parent is
+//     twice as long), and likewise τ·S: Σ τ·S·V² (the filtered medium's emission) is conserved exactly, and a
+//     wall that fills one layer of children keeps its optical depth (tests/test_vct.py).
+//   MODE_ANISO: for direction f, the 4 columns of 2 children along f's axis are composited front to back in the
+//     direction of travel, C = C_front + (1 − α_front)·C_back, α = α_front + (1 − α_front)·α_back (premultiplied
+//     C = α·S), the columns averaged in (C, α), and stored back as τ = −ln(1 − α), τ·S = τ·C/α. A wall one voxel
+//     thick stays opaque at every level for rays crossing it (Crassin et al. 2011).
+// MODE_READ: copy one level of u_src[0] into a buffer (tests and statistics; moderngl reads level 0 only).
+// MODE_FLUX: per row (y, z) of the face textures, Σ_x Σ_g α_g·L_g (rgb) and the occupied voxels (a), for the
+//   flux statistics of vct.face_flux (no float atomics: rows are summed here, rows on the CPU).
+uniform ivec3 u_dst_size;   // size of the level written (or read)
+uniform int u_level;
+
+#if defined(MODE_FLUX)
+layout(local_size_x = 8, local_size_y = 8) in;
+uniform sampler3D u_src[6];
+layout(std430, binding = 0) writeonly buffer Out { vec4 rows[]; };
+void main() {
+    ivec2 yz = ivec2(gl_GlobalInvocationID.xy);
+    if (yz.x >= u_dst_size.y || yz.y >= u_dst_size.z) return;
+    vec4 sum = vec4(0.0);
+    for (int x = 0; x < u_dst_size.x; ++x) {
+        float occupied = 0.0;
+        for (int g = 0; g < 6; ++g) {
+            vec4 f = texelFetch(u_src[g], ivec3(x, yz), 0);
+            sum.rgb += f.a * f.rgb;
+            occupied = max(occupied, float(f.a > 0.0));
+        }
+        sum.a += occupied;
+    }
+    rows[yz.y * u_dst_size.y + yz.x] = sum;
+}
+#elif defined(MODE_READ)
+layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
+uniform sampler3D u_src[1];
+layout(std430, binding = 0) writeonly buffer Out { vec4 texels[]; };
+void main() {
+    ivec3 v = ivec3(gl_GlobalInvocationID);
+    if (any(greaterThanEqual(v, u_dst_size))) return;
+    texels[(v.z * u_dst_size.y + v.y) * u_dst_size.x + v.x] = texelFetch(u_src[0], v, u_level);
+}
+#else
+layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
+#define TAU_MAX 6.907755279   // −ln(1e-3) = −ln(MIN_TRANSMITTANCE) of vct_common.glsl
+
+float depth_of(float alpha) { return min(-log(max(1.0 - alpha, 1e-30)), TAU_MAX); }
+
+// Face (rgb = L, a = α) or composited (rgb = α·S, a = α) → stored (τ·S, τ).
+vec4 stored(vec3 radiance, float alpha) {
+    float tau = alpha > 0.0 ? depth_of(alpha) : 0.0;
+    return vec4(tau * radiance, tau);
+}
+
+#if defined(MODE_ANISO)
+#define VOLUMES 6
+#else
+#define VOLUMES 1
+#endif
+uniform sampler3D u_src[6];   // MODE_BASE: the six face textures; MODE_DOWN: the volumes at level u_level − 1
+layout(rgba32f, binding = 0) uniform writeonly image3D u_dst[VOLUMES];
+
+#if defined(MODE_BASE)
+void main() {
+    ivec3 v = ivec3(gl_GlobalInvocationID);
+    if (any(greaterThanEqual(v, u_dst_size))) return;
+    vec4 face[6];
+    for (int g = 0; g < 6; ++g) face[g] = texelFetch(u_src[g], v, 0);
+#if defined(MODE_ANISO)
+    for (int f = 0; f < 6; ++f) {
+        vec4 s = face[f ^ 1];
+        imageStore(u_dst[f], v, stored(s.rgb, s.a));
+    }
+#else
+    float alpha = 0.0;
+    vec3 radiance = vec3(0.0);
+    for (int g = 0; g < 6; ++g) {
+        if (face[g].a > 0.0) radiance = max(radiance, face[g].rgb);
+        alpha = max(alpha, face[g].a);
+    }
+    imageStore(u_dst[0], v, stored(radiance, alpha));
+#endif
+}
+#endif
+
+#if defined(MODE_DOWN)
+vec4 child(int f, ivec3 c) {
+    return texelFetch(u_src[f], c, u_level - 1);
+}
+
+// Stored (τ·S, τ) → premultiplied (α·S, α).
+vec4 premultiplied(vec4 t) {
+    float alpha = 1.0 - exp(-t.a);
+    return t.a > 0.0 ? vec4(alpha * t.rgb / t.a, alpha) : vec4(0.0);
+}
+
+void main() {
+    ivec3 v = ivec3(gl_GlobalInvocationID);
+    if (any(greaterThanEqual(v, u_dst_size))) return;
+    ivec3 base = 2 * v;
+#if defined(MODE_ANISO)
+    for (int f = 0; f < 6; ++f) {
+        int axis = f >> 1;
+        ivec3 step = ivec3(0);
+        step[axis] = 1;
+        // Travelling +axis, the child with the lower coordinate is in front; travelling −axis, the higher one.
+        bool forward = (f & 1) == 0;
+        vec4 sum = vec4(0.0);
+        for (int j = 0; j < 2; ++j)
+            for (int i = 0; i < 2; ++i) {
+                ivec3 c = base;
+                int u = (axis + 1) % 3, w = (axis + 2) % 3;
+                c[u] += i;
+                c[w] += j;
+                vec4 lo = premultiplied(child(f, c)), hi = premultiplied(child(f, c + step));
+                vec4 front = forward ? lo : hi, back = forward ? hi : lo;
+                sum += front + (1.0 - front.a) * back;
+            }
+        sum *= 0.25;
+        imageStore(u_dst[f], v, sum.a > 0.0 ? stored(sum.rgb / sum.a, sum.a) : vec4(0.0));
+    }
+#else
+    vec4 sum = vec4(0.0);
+    for (int k = 0; k < 8; ++k) sum += child(0, base + ivec3(k & 1, (k >> 1) & 1, k >> 2));
+    imageStore(u_dst[0], v, 0.25 * sum);   // 2 × the mean of 8
+#endif
+}
+#endif
+#endif

@@ -1,0 +1,354 @@
+"""Voxel Cone Tracing (seed 004; Crassin et al. 2011): voxelize → inject direct light → mipmap → bounce → trace.
+
+Passes (pipeline.py wires them into the pass cache):
+  vct_voxelize  the shared GPU voxelizer (voxelize.py) on a grid padded so every mip level nests exactly;
+  vct_inject    per voxel and face, the radiance its surfaces reflect from every light, shadowed exactly as the
+                Diffuse Direct pass (direct_eval.glsl), and the face's coverage (vct_inject.glsl);
+  vct_mipmap    the filtered radiance volumes: isotropic (mean of children) or anisotropic (six directions,
+                composited front to back) (vct_mipmap.glsl, seed 004 §4.4);
+  vct_bounce    bounces − 1 gathers at the voxel faces, each followed by a re-mip (vct_bounce.glsl);
+  vct_trace     diffuse cones per G-buffer pixel → Diffuse Indirect and voxel AO (vct_trace.glsl, seed 004 §4.5.2).
+
+Every scale is derived; the shaders' comments give the derivations (self-occlusion bound, step opacity, anisotropic
+optical depth), `cone_table` gives the cones'. Sky light: the world colour fills what is left of every cone that
+leaves the grid; it lands in Diffuse Indirect here, whereas Cycles counts world light as Diffuse Direct.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from . import direct
+from .grid import Grid
+from .scene import Scene
+
+MAX_CONES = 9  # vct_common.glsl
+CONE_FIELDS = ("diffuse_cones", "diffuse_aperture", "max_distance", "step_multiplier", "start_offset")
+
+
+@dataclass(frozen=True)
+class VctSettings:
+    resolution: int = 64  # voxels along the longest axis of the scene (other axes padded, see vct_grid)
+    diffuse_cones: int = 6  # 1 around the normal + (n − 1) in a ring; 5..9 (cone_table)
+    diffuse_aperture: float = 0.0  # cone half-angle (degrees); 0 = derived: a cone of the region's solid angle
+    max_distance: float = 0.0  # metres a cone travels; 0 = until it leaves the grid (or is fully occluded)
+    bounces: int = 1  # indirect bounces in Diffuse Indirect (1 = light reflected once; Cycles' "1 bounce")
+    step_multiplier: float = 0.5  # step / sampled voxel size (seed 004 listing 4.1 steps by the cone radius)
+    start_offset: float = 1.5  # voxels along the normal (× ‖n‖₁): the trilinear support of the own texel
+    specular_cone: bool = False  # not implemented yet (the G-buffer carries no roughness); must stay False
+    roughness_cutoff: float = 0.5  # specular cone skipped above this roughness (when implemented)
+    anisotropic: bool = False  # six directional volumes (Crassin) instead of one isotropic volume
+    ao_distance: float = 0.0  # metres for voxel AO; 0 = AO is the sky visibility (cones leaving the grid)
+
+    def __post_init__(self):
+        checks = [
+            (16 <= self.resolution <= 512, f"resolution {self.resolution} out of range 16..512"),
+            (5 <= self.diffuse_cones <= MAX_CONES, f"diffuse_cones {self.diffuse_cones} out of range 5..{MAX_CONES}"),
+            (self.diffuse_aperture == 0 or 0 < self.diffuse_aperture < 90,
+             f"diffuse_aperture {self.diffuse_aperture} must be 0 (derived) or in (0, 90) degrees"),
+            (self.max_distance >= 0 and math.isfinite(self.max_distance), "max_distance must be ≥ 0 (0 = unlimited)"),
+            (1 <= self.bounces <= 16, f"bounces {self.bounces} out of range 1..16"),
+            (0.05 <= self.step_multiplier <= 2.0, f"step_multiplier {self.step_multiplier} out of range 0.05..2"),
+            (0.0 <= self.start_offset <= 8.0, f"start_offset {self.start_offset} out of range 0..8 voxels"),
+            (0.0 <= self.roughness_cutoff <= 1.0, f"roughness_cutoff {self.roughness_cutoff} out of range 0..1"),
+            (self.ao_distance >= 0 and math.isfinite(self.ao_distance), "ao_distance must be ≥ 0"),
+            (not self.specular_cone, "specular_cone is not implemented yet"),
+        ]
+        for ok, message in checks:
+            if not ok:
+                raise ValueError(message)
+
+    def key(self, kind: str) -> tuple:
+        """The settings a pass reads: 'bounce' or 'trace' (resolution and anisotropy key the earlier passes)."""
+        extra = ("bounces",) if kind == "bounce" else ("ao_distance", "specular_cone", "roughness_cutoff")
+        d = asdict(self)
+        return tuple((name, d[name]) for name in CONE_FIELDS + extra)
+
+
+def cone_table(count: int, aperture_deg: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Diffuse cones: (unit directions (n, 3) in the normal's frame, z = normal; weights (n,); tan(half-angle) (n,)).
+
+    The hemisphere is cut into n regions of equal solid angle 2π/n: a polar cap θ < θ₁ with 1 − cosθ₁ = 1/n, and
+    n − 1 equal azimuthal sectors of the ring θ₁ ≤ θ ≤ π/2. Cone k stands for region k:
+      weight  w_k = ∫_region cosθ dω:  cap π·sin²θ₁, each sector π·cos²θ₁/(n − 1); Σ w_k = π exactly, so a uniform
+              radiance L gives E = Σ w_k·L = π·L, the exact cosine-weighted hemisphere integral;
+      axis    the region's cosine-weighted mean direction: the normal for the cap; for a sector of width Δφ = 2π/m
+              (m = n − 1), tilted by atan2(2·sin(π/m)·(1 − sin³θ₁), Δφ·cos³θ₁) from the normal
+              (∫ sin²θ cosθ dθ and ∫ cos²θ sinθ dθ over [θ₁, π/2]);
+      aperture half-angle of a cone of the region's solid angle, acos(1 − 1/n) (33.56° for n = 6), unless given.
+    """
+    n, m = int(count), int(count) - 1
+    cos1 = 1.0 - 1.0 / n
+    sin1 = math.sqrt(1.0 - cos1 * cos1)
+    tilt = math.atan2(2.0 * math.sin(math.pi / m) * (1.0 - sin1 ** 3), (2.0 * math.pi / m) * cos1 ** 3)
+    dirs = [(0.0, 0.0, 1.0)]
+    for k in range(m):
+        phi = 2.0 * math.pi * k / m
+        dirs.append((math.sin(tilt) * math.cos(phi), math.sin(tilt) * math.sin(phi), math.cos(tilt)))
+    weights = [math.pi * sin1 ** 2] + [math.pi * cos1 ** 2 / m] * m
+    half = math.radians(aperture_deg) if aperture_deg > 0 else math.acos(1.0 - 1.0 / n)
+    return np.array(dirs), np.array(weights), np.full(n, math.tan(half))
+
+
+def mip_levels(resolution: int) -> int:
+    """Levels down to 4 voxels along the longest axis (64 → 5 levels: 64 … 4); coarser levels would average a
+    room into a handful of voxels, and cones wider than the coarsest voxel just sample it with longer steps."""
+    return max(1, int(math.floor(math.log2(resolution))) - 1)
+
+
+def vct_grid(scene: Scene, settings: VctSettings) -> Grid:
+    """Grid.fit over the scene (1 empty margin voxel, origin snapped to whole cells, seed 004 §4.1), each axis
+    padded up to a multiple of 2^(levels − 1) so every parent voxel has exactly 8 children at every level and
+    the levels' texel centres nest (no half texels at borders)."""
+    lo, hi = scene.bounds()
+    g = Grid.fit(lo, hi, settings.resolution, margin_cells=1)
+    align = 2 ** (mip_levels(settings.resolution) - 1)
+    return Grid(g.origin, g.cell, tuple(-(-n // align) * align for n in g.size))
+
+
+def level_sizes(grid: Grid, levels: int) -> list[tuple]:
+    """Voxels per axis at each mip level (exact halvings: vct_grid pads the axes)."""
+    return [tuple(int(n) >> level for n in grid.size) for level in range(levels)]
+
+
+@dataclass
+class Faces:
+    """Six RGBA32F 3D textures, one per voxel face (outward normal +x, −x, +y, −y, +z, −z): rgb = outgoing
+    radiance through that face, a = its coverage α_g (vct_inject.glsl). `flux`: π·cell²·Σ α_g·L_g (W, RGB)."""
+    textures: list
+    grid: Grid
+    levels: int  # mip levels the volumes built from these faces get
+    flux: list = None
+    occupied: int = 0
+
+    def release(self):
+        for t in self.textures:
+            t.release()
+
+
+@dataclass
+class ConeVolumes:
+    """Filtered radiance (premultiplied rgb = α·L, a = α) with `levels` mip levels: 1 isotropic texture or 6
+    anisotropic ones (direction of travel +x, −x, +y, −y, +z, −z). `owned` False: a view of another pass's
+    volumes (vct_bounce with bounces = 1), which must not release them."""
+    textures: list
+    grid: Grid
+    levels: int
+    anisotropic: bool
+    owned: bool = True
+    faces: Faces | None = None  # the bounced face radiance these volumes were built from (vct_bounce only)
+    bounce_stats: list = None
+
+    def release(self):
+        if self.owned:
+            for t in self.textures:
+                t.release()
+            if self.faces is not None:
+                self.faces.release()
+
+
+def _texture3d(ctx, size, levels: int = 1):
+    import moderngl
+
+    t = ctx.texture3d(tuple(int(n) for n in size), 4, dtype="f4")
+    t.repeat_x = t.repeat_y = t.repeat_z = False
+    if levels > 1:
+        t.build_mipmaps(0, levels - 1)  # allocates the chain; every level is then overwritten by vct_mipmap.glsl
+        t.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
+    else:
+        t.filter = (moderngl.NEAREST, moderngl.NEAREST)
+    return t
+
+
+def _units(prog, name: str, textures: list, first: int) -> int:
+    """Bind `textures` to consecutive texture units from `first` and point sampler (array) `name` at them."""
+    for i, t in enumerate(textures):
+        t.use(location=first + i)
+    if name in prog:
+        units = list(range(first, first + len(textures)))
+        prog[name].value = units if prog[name].array_length > 1 else units[0]
+    return first + len(textures)
+
+
+def _dispatch(prog, size, local: int = 4):
+    prog.run(*((int(n) + local - 1) // local for n in size))
+
+
+def _grid_uniforms(prog, grid: Grid, levels: int = 1):
+    direct._set(prog, "u_grid_origin", tuple(float(c) for c in grid.origin))
+    direct._set(prog, "u_cell", float(grid.cell))
+    direct._set(prog, "u_grid_size", tuple(int(n) for n in grid.size))
+    direct._set(prog, "u_max_lod", float(levels - 1))
+
+
+def voxelize_scene(ctx, programs, scene: Scene, geometry, textures: list, grid: Grid):
+    """The shared voxelizer (rasterised, exact areas) on the VCT grid."""
+    from .voxelize import voxelize
+
+    return voxelize(ctx, programs, scene, geometry, textures, grid)
+
+
+def inject(ctx, programs, vox, shadows, levels: int) -> Faces:
+    """Direct light reflected by every voxel face (vct_inject.glsl); lights, shadows as in direct_light.glsl."""
+    grid = vox.grid
+    faces = Faces([_texture3d(ctx, grid.size) for _ in range(6)], grid, levels)
+    prog = programs.compute("vct_inject.glsl")
+    vox.area.use(location=0)
+    vox.albedo.use(location=1)
+    shadows.depth.use(location=2)
+    direct._set(prog, "u_area", 0)
+    direct._set(prog, "u_albedo", 1)
+    direct._set(prog, "u_shadow_atlas", 2)
+    direct._set(prog, "u_atlas_texel", (1.0 / shadows.size[0], 1.0 / shadows.size[1]))
+    direct._set(prog, "u_light_count", shadows.light_count)
+    _grid_uniforms(prog, grid)
+    shadows.light_ssbo.bind_to_storage_buffer(0)
+    shadows.view_ssbo.bind_to_storage_buffer(1)
+    shadows.polygon_ssbo.bind_to_storage_buffer(2)
+    for unit, t in enumerate(faces.textures):
+        t.bind_to_image(unit, read=False, write=True)
+    _dispatch(prog, grid.size)
+    ctx.memory_barrier()
+    faces.flux, faces.occupied = face_flux(ctx, programs, faces)
+    return faces
+
+
+def face_flux(ctx, programs, faces: Faces) -> tuple[list, int]:
+    """(π·cell²·Σ_voxels Σ_g α_g·L_g per RGB channel — the outgoing flux (W) the faces carry; occupied voxels),
+    summed per row on the GPU (MODE_FLUX) and over rows here."""
+    nx, ny, nz = faces.grid.size
+    out = ctx.buffer(reserve=ny * nz * 16)
+    try:
+        prog = programs.compute("vct_mipmap.glsl", {"MODE_FLUX": None})
+        _units(prog, "u_src", faces.textures, 0)
+        direct._set(prog, "u_dst_size", (int(nx), int(ny), int(nz)))
+        out.bind_to_storage_buffer(0)
+        _dispatch(prog, (ny, nz, 1), local=8)
+        ctx.memory_barrier()
+        rows = np.frombuffer(out.read(), np.float32).reshape(-1, 4).astype(np.float64)
+    finally:
+        out.release()
+    flux = rows[:, :3].sum(axis=0) * math.pi * faces.grid.cell ** 2
+    return [float(c) for c in flux], int(round(rows[:, 3].sum()))
+
+
+def build_volumes(ctx, programs, faces: Faces, anisotropic: bool, into: ConeVolumes | None = None) -> ConeVolumes:
+    """Level 0 from the face radiances, then each level from the one below (vct_mipmap.glsl, seed 004 §4.4).
+    `into`: rebuild existing volumes in place (vct_bounce) instead of allocating new ones."""
+    grid = faces.grid
+    sizes = level_sizes(grid, faces.levels)
+    count = 6 if anisotropic else 1
+    vols = into or ConeVolumes([_texture3d(ctx, grid.size, len(sizes)) for _ in range(count)], grid, len(sizes),
+                               anisotropic)
+    variant = {"MODE_ANISO": None} if anisotropic else {}
+    prog = programs.compute("vct_mipmap.glsl", {"MODE_BASE": None, **variant})
+    _units(prog, "u_src", faces.textures, 0)
+    for unit, t in enumerate(vols.textures):
+        t.bind_to_image(unit, read=False, write=True, level=0)
+    direct._set(prog, "u_dst_size", sizes[0])
+    _dispatch(prog, sizes[0])
+    ctx.memory_barrier()
+    prog = programs.compute("vct_mipmap.glsl", {"MODE_DOWN": None, **variant})
+    _units(prog, "u_src", vols.textures, 0)
+    for level in range(1, len(sizes)):
+        for unit, t in enumerate(vols.textures):
+            t.bind_to_image(unit, read=False, write=True, level=level)
+        direct._set(prog, "u_dst_size", sizes[level])
+        direct._set(prog, "u_level", level)
+        _dispatch(prog, sizes[level])
+        ctx.memory_barrier()
+    return vols
+
+
+def _cone_uniforms(prog, grid: Grid, levels: int, s: VctSettings, world) -> None:
+    """Grid, cone table and trace settings of vct_common.glsl."""
+    dirs, weights, tans = cone_table(s.diffuse_cones, s.diffuse_aperture)
+    n = len(weights)
+    cones = np.zeros((MAX_CONES, 4), np.float32)
+    cones[:n, :3], cones[:n, 3] = dirs, weights
+    tan = np.zeros(MAX_CONES, np.float32)
+    tan[:n] = tans
+    if "u_cones" in prog:
+        prog["u_cones"].write(cones.tobytes())
+    if "u_cone_tan" in prog:
+        prog["u_cone_tan"].write(tan.tobytes())
+    _grid_uniforms(prog, grid, levels)
+    for name, value in (("u_cone_count", n), ("u_step", float(s.step_multiplier)),
+                        ("u_offset", float(s.start_offset)), ("u_max_distance", float(s.max_distance)),
+                        ("u_ao_distance", float(s.ao_distance)), ("u_world", tuple(float(c) for c in world[:3]))):
+        direct._set(prog, name, value)
+
+
+def bounce(ctx, programs, vox, direct_faces: Faces, volumes: ConeVolumes, s: VctSettings, world) -> ConeVolumes:
+    """bounces − 1 gathers at the voxel faces (vct_bounce.glsl), each followed by a re-mip. Returns the volumes
+    the final gather reads (a non-owning view of `volumes` when bounces = 1); `bounce_stats` lists the flux the
+    faces carry after each bounce (bounce 1 = direct light reflected once)."""
+    stats = [{"bounce": 1, "flux": direct_faces.flux}]
+    if s.bounces <= 1:
+        return ConeVolumes(volumes.textures, volumes.grid, volumes.levels, volumes.anisotropic, owned=False,
+                           bounce_stats=stats)
+    grid = direct_faces.grid
+    faces = Faces([_texture3d(ctx, grid.size) for _ in range(6)], grid, direct_faces.levels)
+    prog = programs.compute("vct_bounce.glsl", {"MODE_ANISO": None} if volumes.anisotropic else None)
+    own, source = None, volumes
+    for b in range(2, s.bounces + 1):
+        unit = _units(prog, "u_volume", source.textures, 0)
+        unit = _units(prog, "u_direct", direct_faces.textures, unit)
+        _units(prog, "u_albedo", [vox.albedo], unit)
+        _cone_uniforms(prog, grid, volumes.levels, s, world)
+        for i, t in enumerate(faces.textures):
+            t.bind_to_image(i, read=False, write=True)
+        _dispatch(prog, grid.size)
+        ctx.memory_barrier()
+        own = source = build_volumes(ctx, programs, faces, volumes.anisotropic, into=own)
+        stats.append({"bounce": b, "flux": face_flux(ctx, programs, faces)[0]})
+    own.faces, own.bounce_stats = faces, stats
+    return own
+
+
+def trace(ctx, programs, gbuffer, volumes: ConeVolumes, s: VctSettings, world) -> dict:
+    """Diffuse cones per G-buffer pixel (vct_trace.glsl): {'indirect': RGBA32F texture, rgb = Diffuse Indirect
+    (irradiance/π), a = voxel AO}."""
+    w, h = gbuffer.size
+    out = ctx.texture((w, h), 4, dtype="f4")
+    prog = programs.compute("vct_trace.glsl", {"MODE_ANISO": None} if volumes.anisotropic else None)
+    unit = _units(prog, "u_volume", volumes.textures, 0)
+    for name in ("position", "normal", "geo_normal"):
+        unit = _units(prog, f"u_{name}", [gbuffer.textures[name]], unit)
+    _cone_uniforms(prog, volumes.grid, volumes.levels, s, world)
+    direct._set(prog, "u_image_size", (w, h))
+    out.bind_to_image(0, read=False, write=True)
+    prog.run((w + 7) // 8, (h + 7) // 8, 1)
+    return {"indirect": out}
+
+
+def read_ao(texture) -> np.ndarray:
+    """Voxel AO (H, W) from vct_trace's texture, rows top-to-bottom."""
+    return direct.read_texture(texture, 4)[..., 3]
+
+
+def read_level(ctx, programs, texture, grid: Grid, level: int) -> np.ndarray:
+    """One mip level of a volume texture as (nz, ny, nx, 4) float32 (vct_mipmap.glsl MODE_READ)."""
+    nx, ny, nz = (int(n) >> level for n in grid.size)
+    out = ctx.buffer(reserve=nx * ny * nz * 16)
+    try:
+        prog = programs.compute("vct_mipmap.glsl", {"MODE_READ": None})
+        _units(prog, "u_src", [texture], 0)
+        direct._set(prog, "u_dst_size", (nx, ny, nz))
+        direct._set(prog, "u_level", level)
+        out.bind_to_storage_buffer(0)
+        _dispatch(prog, (nx, ny, nz))
+        ctx.memory_barrier()
+        return np.frombuffer(out.read(), np.float32).reshape(nz, ny, nx, 4).copy()
+    finally:
+        out.release()
+
+
+def render_info(faces: Faces, volumes: ConeVolumes, s: VctSettings) -> dict:
+    """RenderResult.info for method 'vct': grid, levels, occupancy, flux per bounce."""
+    g = faces.grid
+    return {"grid": list(g.size), "cell": g.cell, "origin": list(g.origin), "levels": faces.levels,
+            "anisotropic": s.anisotropic, "occupied_voxels": faces.occupied, "cones": s.diffuse_cones,
+            "bounces": [dict(b) for b in (volumes.bounce_stats or [])]}
