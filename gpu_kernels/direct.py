@@ -161,11 +161,27 @@ def render_gbuffer(ctx, programs, scene: Scene, geometry: GeometryBuffers, textu
     cam_world = np.asarray(camera.matrix_world, np.float64)
     forward = -cam_world[:3, 2] / np.linalg.norm(cam_world[:3, 2])
     prog["u_view_projection"].write((proj @ view).T.astype("f4").tobytes())
-    _set(prog, "u_camera_position", tuple(cam_world[:3, 3]))
-    _set(prog, "u_camera_forward", tuple(forward))
-    _set(prog, "u_camera_ortho", camera.type == "ORTHO")
+    set_uniform(prog, "u_camera_position", tuple(cam_world[:3, 3]))
+    set_uniform(prog, "u_camera_forward", tuple(forward))
+    set_uniform(prog, "u_camera_ortho", camera.type == "ORTHO")
     draw_by_material(prog, scene, geometry, textures)
     return GBuffer(targets, depth, fbo, (width, height))
+
+
+def bind_material(prog, scene: Scene, mat_index: int, textures: list) -> None:
+    """Set the material uniforms of materials_common.glsl for one material (unused ones are skipped)."""
+    mat = scene.materials[mat_index] if 0 <= mat_index < len(scene.materials) else None
+    base = mat.base_color if mat else (0.8, 0.8, 0.8)
+    set_uniform(prog, "u_base_color", tuple(float(c) for c in base[:3]))
+    set_uniform(prog, "u_metallic", float(mat.metallic) if mat else 0.0)
+    set_uniform(prog, "u_roughness", float(mat.roughness) if mat else 0.5)
+    set_uniform(prog, "u_specular_layer", bool(mat and mat.specular_layer))
+    set_uniform(prog, "u_emission", tuple(float(c) for c in (mat.emission if mat else (0, 0, 0))[:3]))
+    use_tex = bool(mat and 0 <= mat.base_color_texture < len(textures))
+    set_uniform(prog, "u_use_texture", use_tex)
+    if use_tex:
+        textures[mat.base_color_texture].use(location=0)
+        set_uniform(prog, "u_base_texture", 0)
 
 
 def draw_by_material(prog, scene: Scene, geometry: GeometryBuffers, textures: list, vao=None) -> None:
@@ -174,22 +190,11 @@ def draw_by_material(prog, scene: Scene, geometry: GeometryBuffers, textures: li
 
     vao = vao or geometry.vao_full
     for mat_index, first, count in geometry.ranges:
-        mat = scene.materials[mat_index] if 0 <= mat_index < len(scene.materials) else None
-        base = mat.base_color if mat else (0.8, 0.8, 0.8)
-        _set(prog, "u_base_color", tuple(float(c) for c in base[:3]))
-        _set(prog, "u_metallic", float(mat.metallic) if mat else 0.0)
-        _set(prog, "u_roughness", float(mat.roughness) if mat else 0.5)
-        _set(prog, "u_specular_layer", bool(mat and mat.specular_layer))
-        _set(prog, "u_emission", tuple(float(c) for c in (mat.emission if mat else (0, 0, 0))[:3]))
-        use_tex = bool(mat and 0 <= mat.base_color_texture < len(textures))
-        _set(prog, "u_use_texture", use_tex)
-        if use_tex:
-            textures[mat.base_color_texture].use(location=0)
-            _set(prog, "u_base_texture", 0)
+        bind_material(prog, scene, mat_index, textures)
         vao.render(moderngl.TRIANGLES, vertices=count, first=first)
 
 
-def _set(prog, name, value):
+def set_uniform(prog, name, value):
     """Set a uniform if the compiler kept it (unused uniforms are optimised away)."""
     if name in prog:
         prog[name].value = value
@@ -203,12 +208,12 @@ def render_direct_light(ctx, programs, gbuffer: GBuffer, shadows: ShadowAtlas):
     out.bind_to_image(0, read=False, write=True)
     for unit, name in enumerate(("position", "normal", "geo_normal")):
         gbuffer.textures[name].use(location=unit)
-        _set(prog, f"u_{name}", unit)
+        set_uniform(prog, f"u_{name}", unit)
     shadows.depth.use(location=3)
-    _set(prog, "u_shadow_atlas", 3)
-    _set(prog, "u_atlas_texel", (1.0 / shadows.size[0], 1.0 / shadows.size[1]))
-    _set(prog, "u_light_count", shadows.light_count)
-    _set(prog, "u_size", (w, h))
+    set_uniform(prog, "u_shadow_atlas", 3)
+    set_uniform(prog, "u_atlas_texel", (1.0 / shadows.size[0], 1.0 / shadows.size[1]))
+    set_uniform(prog, "u_light_count", shadows.light_count)
+    set_uniform(prog, "u_size", (w, h))
     shadows.light_ssbo.bind_to_storage_buffer(0)
     shadows.view_ssbo.bind_to_storage_buffer(1)
     shadows.polygon_ssbo.bind_to_storage_buffer(2)
@@ -221,3 +226,6 @@ def read_texture(texture, components: int = 4) -> np.ndarray:
     w, h = texture.size
     data = np.frombuffer(texture.read(), np.float32).reshape(h, w, 4)
     return np.ascontiguousarray(data[::-1, :, :components])
+
+
+_set = set_uniform  # short alias used throughout gpu_kernels

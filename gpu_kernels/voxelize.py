@@ -21,6 +21,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import shader_preprocessor as spp
+from .direct import bind_material
+from .direct import set_uniform as _set
 from .grid import Grid
 from .scene import Scene
 
@@ -229,24 +231,6 @@ def _tessellation_buffers(ctx, scene: Scene, grid: Grid, supersample: int):
     return ctx.buffer(data.tobytes() or b"\0" * 44), ranges
 
 
-def _set(prog, name, value):
-    if name in prog:
-        prog[name].value = value
-
-
-def _bind_material(prog, scene: Scene, mat_index: int, textures: list) -> None:
-    """Material uniforms of voxelize_common.glsl (mirrors direct.render_gbuffer's binding)."""
-    mat = scene.materials[mat_index] if 0 <= mat_index < len(scene.materials) else None
-    _set(prog, "u_base_color", tuple(float(c) for c in (mat.base_color if mat else (0.8, 0.8, 0.8))[:3]))
-    _set(prog, "u_metallic", float(mat.metallic) if mat else 0.0)
-    _set(prog, "u_emission", tuple(float(c) for c in (mat.emission if mat else (0.0, 0.0, 0.0))[:3]))
-    use_tex = bool(mat and 0 <= mat.base_color_texture < len(textures))
-    _set(prog, "u_use_texture", use_tex)
-    if use_tex:
-        textures[mat.base_color_texture].use(location=0)
-        _set(prog, "u_base_texture", 0)
-
-
 def _draw_raster(ctx, programs, scene, geometry, textures, grid, supersample, uniforms) -> None:
     import moderngl
 
@@ -262,7 +246,7 @@ def _draw_raster(ctx, programs, scene, geometry, textures, grid, supersample, un
         fbo.viewport = (0, 0, side, side)
         ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
         for mat_index, first, count in geometry.ranges:
-            _bind_material(prog, scene, mat_index, textures)
+            bind_material(prog, scene, mat_index, textures)
             vao.render(moderngl.TRIANGLES, vertices=count, first=first)
     finally:
         vao.release()
@@ -283,7 +267,7 @@ def _draw_tessellated(ctx, programs, scene, buffers, textures, uniforms) -> None
         fbo.use()
         ctx.patch_vertices = 3
         for mat_index, first, count in ranges:
-            _bind_material(prog, scene, mat_index, textures)
+            bind_material(prog, scene, mat_index, textures)
             vao.render(moderngl.PATCHES, vertices=count, first=first)
     finally:
         ctx.disable(moderngl.RASTERIZER_DISCARD)

@@ -1,22 +1,7 @@
 // G-buffer from the scene camera: world position, shading normal, diffuse colour, emission, geometric normal.
 // Sampled at pixel centres with no MSAA, like Cycles with a ~0.01 px pixel filter (design.md §3).
 #if defined(VERTEX_SHADER)
-layout(location = 0) in vec3 in_position;
-layout(location = 1) in vec3 in_normal;
-layout(location = 2) in vec2 in_uv;
-layout(location = 3) in vec3 in_geo_normal;
-uniform mat4 u_view_projection;
-out vec3 v_position;
-out vec3 v_normal;
-out vec2 v_uv;
-out vec3 v_geo_normal;
-void main() {
-    v_position = in_position;
-    v_normal = in_normal;
-    v_uv = in_uv;
-    v_geo_normal = in_geo_normal;
-    gl_Position = u_view_projection * vec4(in_position, 1.0);
-}
+#include "surface_vertex.glsl"
 #endif
 
 #if defined(FRAGMENT_SHADER)

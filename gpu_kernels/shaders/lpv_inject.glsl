@@ -4,7 +4,7 @@
 // Because Φ carries the texel's world area, the result does not depend on the RSM resolution.
 #include "lights_common.glsl"
 #include "light_eval.glsl"
-#include "lpv_common.glsl"
+#include "lpv_fixed.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 uniform sampler2D u_rsm_position;
@@ -15,7 +15,6 @@ uniform int u_rsm_resolution;     // texels per RSM view side
 uniform vec3 u_grid_origin;
 uniform float u_grid_cell;
 uniform ivec3 u_grid_size;
-uniform float u_fixed_scale;
 
 struct RsmView {
     vec4 params;   // x: tan(half fov) (perspective) or 0; y: texel world size (orthographic); z: light; w: sample k
@@ -24,7 +23,6 @@ struct RsmView {
     vec4 right;    // xyz right vector of the view; w: unused (with axis and up: tangent-plane coordinates)
 };
 layout(std430, binding = 3) readonly buffer RsmViewBuffer { RsmView rsm_views[]; };
-layout(std430, binding = 4) buffer LpvAccum { int accum[]; };  // 12 ints per cell: RGB × 4 SH coefficients
 
 // Solid angle of one texel of a perspective view with tan(half fov) m at tangent-plane point (x, y):
 // (2m/res)² / (1 + x² + y²)^(3/2).
@@ -77,13 +75,6 @@ vec3 vpl_flux(RsmView v, vec3 p, vec3 n, vec3 albedo) {
     return albedo * color * psa * cos_k * texel_solid_angle(v, p) / wsum;
 }
 
-void add_fixed(int base, vec4 c) {
-    atomicAdd(accum[base + 0], int(round(c.x * u_fixed_scale)));
-    atomicAdd(accum[base + 1], int(round(c.y * u_fixed_scale)));
-    atomicAdd(accum[base + 2], int(round(c.z * u_fixed_scale)));
-    atomicAdd(accum[base + 3], int(round(c.w * u_fixed_scale)));
-}
-
 void main() {
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(px, u_rsm_size))) return;
@@ -94,13 +85,5 @@ void main() {
     vec3 albedo = texelFetch(u_rsm_albedo, px, 0).rgb;
     vec3 flux = vpl_flux(v, pos.xyz, n, albedo);
     if (max(flux.r, max(flux.g, flux.b)) <= 0.0) return;
-    LpvGrid g = LpvGrid(u_grid_origin, u_grid_cell, u_grid_size);
-    // Half a cell along the normal: the VPL lands in the cell in front of its surface (seed 000 §3.3).
-    ivec3 c = lpv_cell(g, pos.xyz + n * 0.5 * g.cell);
-    if (!lpv_inside(g, c)) return;
-    vec4 lobe = sh_clamped_cosine(n) / PI;
-    int base = lpv_index(g, c) * 12;
-    add_fixed(base + 0, lobe * flux.r);
-    add_fixed(base + 4, lobe * flux.g);
-    add_fixed(base + 8, lobe * flux.b);
+    inject_lambertian(LpvGrid(u_grid_origin, u_grid_cell, u_grid_size), pos.xyz, n, flux);
 }

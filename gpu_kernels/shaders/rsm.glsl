@@ -2,22 +2,7 @@
 // surfels the light sees — world position (w = view index + 1), normal facing the light, diffuse albedo. The
 // injection pass turns each texel into a VPL whose flux it derives from these and the light's units.
 #if defined(VERTEX_SHADER)
-layout(location = 0) in vec3 in_position;
-layout(location = 1) in vec3 in_normal;
-layout(location = 2) in vec2 in_uv;
-layout(location = 3) in vec3 in_geo_normal;
-uniform mat4 u_view_projection;
-out vec3 v_position;
-out vec3 v_normal;
-out vec2 v_uv;
-out vec3 v_geo_normal;
-void main() {
-    v_position = in_position;
-    v_normal = in_normal;
-    v_uv = in_uv;
-    v_geo_normal = in_geo_normal;
-    gl_Position = u_view_projection * vec4(in_position, 1.0);
-}
+#include "surface_vertex.glsl"
 #endif
 
 #if defined(FRAGMENT_SHADER)
