@@ -355,6 +355,9 @@ def propagate_all(ctx, programs, states: list, geometry_volumes: list, settings:
     stats = []
     for state, gv in zip(states, geometry_volumes):
         copy_volumes(ctx, state.injected, state.accum)  # the injected light itself lights nearby surfaces
+        state.face_flux.clear()
+        if gv is not None:
+            absorb(ctx, programs, state, gv, add=False)  # zeros, should no light reach this cascade
         bounces = []
         source, flux = state.injected, state.injected_flux
         for bounce in range(max(1, settings.bounces) if gv is not None else 1):
