@@ -247,10 +247,20 @@ def _grid_uniforms(prog, grid: Grid) -> None:
     direct._set(prog, "u_grid_size", tuple(int(c) for c in grid.size))
 
 
-def inject(ctx, programs, rsm: Rsm, shadows, state: LpvGridState) -> float:
-    """RSM texels → fixed-point SH sums → state.injected. Returns the injected flux (W, sum of RGB)."""
+def sky_flux_bound(grid: Grid, world_color) -> float:
+    """Flux the world can push through the grid's border faces: π·L_max·(border area)."""
+    nx, ny, nz = grid.size
+    border = 2 * (nx * ny + ny * nz + nx * nz) * grid.cell ** 2
+    return math.pi * float(max(world_color[:3])) * border
+
+
+def inject(ctx, programs, rsm: Rsm, shadows, state: LpvGridState, world_color=(0.0, 0.0, 0.0),
+           gv=None) -> float:
+    """RSM texels (and world light at the open border) → fixed-point SH sums → state.injected. Returns the
+    injected flux (W, sum of RGB)."""
     grid = state.grid
-    scale = FIXED_RANGE / rsm.flux_bound
+    sky = max(world_color[:3]) > 0
+    scale = FIXED_RANGE / (rsm.flux_bound + (sky_flux_bound(grid, world_color) if sky else 0.0))
     state.accum_ints.clear()
     prog = programs.compute("lpv_inject.glsl")
     for unit, tex in enumerate((rsm.position, rsm.normal, rsm.albedo)):
@@ -268,6 +278,18 @@ def inject(ctx, programs, rsm: Rsm, shadows, state: LpvGridState) -> float:
     rsm.views_ssbo.bind_to_storage_buffer(3)
     state.accum_ints.bind_to_storage_buffer(4)
     prog.run((rsm.size[0] + 7) // 8, (rsm.size[1] + 7) // 8, 1)
+    if sky:
+        sky_prog = programs.compute("lpv_sky.glsl")
+        _grid_uniforms(sky_prog, grid)
+        direct._set(sky_prog, "u_world", tuple(float(c) for c in world_color[:3]))
+        direct._set(sky_prog, "u_fixed_scale", float(scale))
+        direct._set(sky_prog, "u_occlusion", gv is not None)
+        if gv is not None:
+            gv.blocking.use(location=0)
+        direct._set(sky_prog, "u_geometry", 0)
+        state.accum_ints.bind_to_storage_buffer(4)
+        nx, ny, nz = grid.size
+        sky_prog.run((nx + 3) // 4, (ny + 3) // 4, (nz + 3) // 4)
     return resolve(ctx, programs, state, scale, state.injected)
 
 
@@ -339,12 +361,16 @@ def copy_volumes(ctx, src: Volumes, dst: Volumes) -> None:
         b.write(a.read())
 
 
-def inject_all(ctx, programs, rsm: Rsm, shadows, grids: list) -> list:
-    """Inject the RSM VPLs into a fresh state per cascade (finest first)."""
+def inject_all(ctx, programs, rsm: Rsm, shadows, grids: list, world_color=(0.0, 0.0, 0.0),
+               geometry_volumes=None) -> list:
+    """Inject the RSM VPLs and the world light into a fresh state per cascade (finest first). World light enters
+    each cascade through its open border: exact for the coarsest grid, whose border is the scene's; a finer
+    cascade assumes the world is visible beyond its border (true outdoors, too bright inside closed rooms)."""
     states = []
-    for grid in grids:
+    for i, grid in enumerate(grids):
         state = LpvGridState(ctx, grid)
-        state.injected_flux = inject(ctx, programs, rsm, shadows, state)
+        gv = geometry_volumes[i] if geometry_volumes else None
+        state.injected_flux = inject(ctx, programs, rsm, shadows, state, world_color, gv)
         states.append(state)
     return states
 

@@ -125,7 +125,7 @@ class Pipeline:
 
     def _lpv(self, scene, settings, geometry, textures, shadows, gbuffer, k_geometry, k_materials, k_shadow,
              k_gbuffer):
-        """LPV passes: rsm ← shadow views; lpv_inject ← rsm, grids; geometry_volume ← geometry, grids;
+        """LPV passes: rsm ← shadow views; geometry_volume ← geometry, grids; lpv_inject ← rsm, grids, world;
         lpv_propagate ← injection, geometry volume, LPV settings; lpv_lighting ← gbuffer, propagation."""
         ctx, programs, cache, s = self.ctx, self.programs, self.cache, settings.lpv
         grids = lpv.cascade_grids(scene, s)
@@ -133,11 +133,12 @@ class Pipeline:
         k_rsm = (k_shadow, s.rsm_resolution)
         rsm = cache.run("rsm", k_rsm, lambda: lpv.render_rsm(ctx, programs, scene, geometry, textures, shadows,
                                                              s.rsm_resolution))
-        k_inject = (k_rsm, k_grids)
-        states = cache.run("lpv_inject", k_inject, lambda: lpv.inject_all(ctx, programs, rsm, shadows, grids))
         k_gv = (k_geometry, k_materials, k_grids, s.occlusion)
         gvs = cache.run("geometry_volume", k_gv, lambda: lpv.geometry_volumes(
             ctx, programs, scene, geometry, textures, grids) if s.occlusion else [None] * len(grids))
+        k_inject = (k_rsm, k_grids, k_gv, _hash(scene.world))
+        states = cache.run("lpv_inject", k_inject, lambda: lpv.inject_all(ctx, programs, rsm, shadows, grids,
+                                                                          scene.world.color, gvs))
         k_prop = (k_inject, k_gv, repr(s))
         stats = cache.run("lpv_propagate", k_prop, lambda: lpv.propagate_all(ctx, programs, states, gvs, s))
         k_light = (k_gbuffer, k_prop)
