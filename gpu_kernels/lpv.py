@@ -1,12 +1,15 @@
 """Light Propagation Volumes (seeds 000, 001, 002): RSMs → VPL injection → propagation with fuzzy occlusion →
-irradiance lookup. Every scale is derived, none tuned (see the shaders' comments):
+absorbed light → irradiance. Every scale is derived, none tuned (see the shaders' comments):
 
 - RSM texel → VPL flux Φ = albedo × irradiance × texel area (lpv_inject.glsl), so injection is independent of
-  the RSM resolution;
+  the RSM resolution; world light enters through the grid's open border (lpv_sky.glsl);
 - a VPL is the Lambertian intensity (Φ/π)·max(0, n·ω) on 2-band SH, in the cell half a cell in front of it;
 - propagation conserves flux exactly in empty space (far face 0.4006696846 sr + 4 side faces 0.4234313544 sr
   = 2π/3 per neighbour); negative lobes propagate as they are unless `clamp_negative` (which adds energy);
-- lookup: irradiance = SH intensity convolved with the cosine / cell².
+- lookup (default "flux"): a surface's irradiance is the flux fuzzy occlusion stopped at it, per area — summed
+  over all surfaces this is exactly the injected flux that did not leave the grid (lpv_occlusion.py); the
+  classic lookup, SH intensity convolved with the cosine / cell², is `lookup="intensity"`;
+- bounces: absorbed light × albedo is injected again.
 
 Iterations stop adaptively once a step moves less than `epsilon` of the injected flux.
 """
@@ -20,101 +23,10 @@ import numpy as np
 from . import direct
 from . import light_buffers as lb
 from .grid import Grid
+from .lpv_occlusion import GeometryVolume, absorb, geometry_volumes, inject_bounce  # noqa: F401 (pipeline uses lpv.*)
+from .lpv_state import (FIXED_RANGE, SH_FLUX, LpvGridState, LpvSettings, Volumes, _grid_uniforms,  # noqa: F401
+                        _volumes, copy_volumes, resolve, transfer_matrices)
 from .scene import Scene
-
-FAR_FACE = 0.4006696846  # solid angle of the far face of the next cell, seen from a cell centre (design.md §3)
-SIDE_FACE = 0.4234313544  # each of its four side faces; FAR_FACE + 4·SIDE_FACE = 2π/3
-AXES = ((1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0, -1))
-FIXED_RANGE = 2.0 ** 29  # fixed-point headroom: a cell's coefficient sum stays below 2³¹ (see flux_bound)
-SH_FLUX = 2.0 * math.sqrt(math.pi)  # flux of SH coefficients c: c0·2√π
-
-
-@dataclass(frozen=True)
-class LpvSettings:
-    resolution: int = 32  # cells along the longest axis of the (finest) grid
-    cascades: int = 1  # nested grids, each twice the extent of the last
-    rsm_resolution: int = 128  # texels per side of each RSM view (sun: twice that)
-    max_iterations: int = 64
-    epsilon: float = 1e-3  # stop when one step moved less than this fraction of the injected flux
-    occlusion: bool = True  # fuzzy occlusion from the geometry volume
-    clamp_negative: bool = False
-    damping: bool = False  # seed 000's directional-derivative damping at lookup
-    blend_cells: float = 2.0  # cascade border blend width (cells)
-    bounces: int = 3  # indirect bounces (1 = light reflected once); bounces > 1 need occlusion
-    lookup: str = "flux"  # "flux": absorbed face flux per area (conserves energy); "intensity": Kaplanyan's I/cell²
-
-    def __post_init__(self):
-        if not 4 <= self.resolution <= 256:
-            raise ValueError(f"resolution {self.resolution} out of range 4..256")
-        if not 1 <= self.cascades <= 4:
-            raise ValueError(f"cascades {self.cascades} out of range 1..4")
-        if self.lookup not in ("flux", "intensity"):
-            raise ValueError(f"lookup must be 'flux' or 'intensity', not {self.lookup!r}")
-        if self.bounces < 1 or self.max_iterations < 1 or self.rsm_resolution < 8:
-            raise ValueError("bounces and max_iterations must be ≥ 1 and rsm_resolution ≥ 8")
-
-
-def sh_basis(d) -> np.ndarray:
-    x, y, z = d
-    return np.array([0.282094792, -0.488602512 * y, 0.488602512 * z, -0.488602512 * x])
-
-
-def sh_clamped_cosine(n) -> np.ndarray:
-    x, y, z = n
-    return np.array([0.886226925, -1.023326708 * y, 1.023326708 * z, -1.023326708 * x])
-
-
-def transfer_matrices() -> tuple[np.ndarray, np.ndarray]:
-    """The face scheme of lpv_propagate.glsl as linear maps, one per neighbour direction d (light travelling d):
-    T_d = Σ_faces (lobe(face)/π) ⊗ Y(ω_face)·Δω_face (coefficients received), and the incident-flux row
-    Σ_faces Y(ω_face)·Δω_face. Returns (6, 4, 4) and (6, 4) float32."""
-    transfer = np.zeros((6, 4, 4))
-    incident = np.zeros((6, 4))
-    for n, d in enumerate(AXES):
-        d = np.asarray(d, float)
-        for f in AXES:
-            f = np.asarray(f, float)
-            if f @ d < -0.5:
-                continue  # the face shared with the neighbour
-            far = f @ d > 0.5
-            w = d if far else (d + 0.5 * f) / np.linalg.norm(d + 0.5 * f)
-            weight = sh_basis(w) * (FAR_FACE if far else SIDE_FACE)
-            transfer[n] += np.outer(sh_clamped_cosine(f) / math.pi, weight)
-            incident[n] += weight
-    return transfer.astype(np.float32), incident.astype(np.float32)
-
-
-@dataclass
-class Volumes:
-    """Three RGBA32F 3D textures (SH coefficients of red, green, blue) on one grid."""
-    r: object
-    g: object
-    b: object
-
-    def release(self):
-        for t in (self.r, self.g, self.b):
-            t.release()
-
-    def textures(self):
-        return self.r, self.g, self.b
-
-
-def _volumes(ctx, grid: Grid, data: np.ndarray | None = None) -> Volumes:
-    import moderngl
-
-    size = tuple(int(v) for v in grid.size)
-    texs = []
-    for i in range(3):
-        payload = None if data is None else np.ascontiguousarray(data[..., i, :], np.float32).tobytes()
-        t = ctx.texture3d(size, 4, payload, dtype="f4")
-        t.filter = (moderngl.LINEAR, moderngl.LINEAR)
-        t.repeat_x = t.repeat_y = t.repeat_z = False
-        texs.append(t)
-    if data is None:
-        for t in texs:
-            t.write(np.zeros(size[::-1] + (4,), np.float32).tobytes())
-    return Volumes(*texs)
-
 
 def cascade_grids(scene: Scene, settings: LpvSettings) -> list[Grid]:
     """The coarsest cascade covers the scene; each finer one has half the cell size, centred on the camera
@@ -198,7 +110,7 @@ def render_rsm(ctx, programs, scene: Scene, geometry, textures, shadows, resolut
     for i, (view, (x, y, w, h)) in enumerate(zip(views, tiles)):
         fbo.viewport = (x, y, w, h)
         prog["u_view_projection"].write(view.view_projection.T.astype("f4").tobytes())
-        right, up, back = view.view_matrix[0, :3], view.view_matrix[1, :3], view.view_matrix[2, :3]
+        right, back = view.view_matrix[0, :3], view.view_matrix[2, :3]  # rows of world → view: right, up, back
         direct._set(prog, "u_origin", tuple(float(c) for c in view.origin))
         direct._set(prog, "u_forward", tuple(float(c) for c in -back))
         direct._set(prog, "u_ortho", bool(view.ortho))
@@ -212,39 +124,7 @@ def render_rsm(ctx, programs, scene: Scene, geometry, textures, shadows, resolut
         records[i]["origin"] = (*view.origin, 1.0 if view.ortho else 0.0)
         records[i]["axis"] = (*-back, 0.0)
         records[i]["right"] = (*right, 0.0)
-        del up
     return Rsm(*targets, direct.ssbo(ctx, records), size, resolution // scale, flux_bound(buffers), vao, fbo, depth)
-
-
-class LpvGridState:
-    """GPU state of one cascade: injection accumulator, ping-pong volumes and the accumulation volume."""
-
-    def __init__(self, ctx, grid: Grid):
-        self.grid = grid
-        n = int(np.prod(grid.size))
-        self.accum_ints = ctx.buffer(reserve=n * 12 * 4)
-        self.injected = _volumes(ctx, grid)
-        self.accum = _volumes(ctx, grid)
-        self.ping = _volumes(ctx, grid)
-        self.pong = _volumes(ctx, grid)
-        self.injected_next = _volumes(ctx, grid)  # a bounce's source (ping/pong are the propagation buffers)
-        self.counter = ctx.buffer(reserve=4)
-        self.face_flux = ctx.buffer(reserve=n * 6 * 16)  # vec4 per cell and direction of travel
-        self.front = self.back = None  # absorbed-light irradiance per fine voxel, last pass (set by `absorb`)
-        self.front_total = self.back_total = None  # summed over bounces
-
-    def release(self):
-        for obj in (self.accum_ints, self.injected, self.accum, self.ping, self.pong, self.injected_next,
-                    self.counter, self.face_flux,
-                    self.front, self.back, self.front_total, self.back_total):
-            if obj is not None:
-                obj.release()
-
-
-def _grid_uniforms(prog, grid: Grid) -> None:
-    direct._set(prog, "u_grid_origin", tuple(float(c) for c in grid.origin))
-    direct._set(prog, "u_grid_cell", float(grid.cell))
-    direct._set(prog, "u_grid_size", tuple(int(c) for c in grid.size))
 
 
 def sky_flux_bound(grid: Grid, world_color) -> float:
@@ -291,20 +171,6 @@ def inject(ctx, programs, rsm: Rsm, shadows, state: LpvGridState, world_color=(0
         nx, ny, nz = grid.size
         sky_prog.run((nx + 3) // 4, (ny + 3) // 4, (nz + 3) // 4)
     return resolve(ctx, programs, state, scale, state.injected)
-
-
-def resolve(ctx, programs, state: LpvGridState, scale: float, target: Volumes, add: bool = False) -> float:
-    """Fixed-point sums → float volumes; returns the flux they hold (sum over RGB of |band 0|·2√π)."""
-    prog = programs.compute("lpv_resolve.glsl", {"MODE_ADD": 1} if add else None)
-    state.accum_ints.bind_to_storage_buffer(4)
-    for unit, tex in enumerate(target.textures()):
-        tex.bind_to_image(unit, read=True, write=True)
-    direct._set(prog, "u_grid_size", tuple(int(c) for c in state.grid.size))
-    direct._set(prog, "u_fixed_scale", float(scale))
-    nx, ny, nz = state.grid.size
-    prog.run((nx + 3) // 4, (ny + 3) // 4, (nz + 3) // 4)
-    ints = np.frombuffer(state.accum_ints.read(), np.int32).reshape(-1, 3, 4)
-    return float(np.abs(ints[:, :, 0].astype(np.float64)).sum() / scale * SH_FLUX)
 
 
 CHECK_EVERY = 4  # propagation steps between reads of the moved-flux counter (each read waits for the GPU)
@@ -356,30 +222,25 @@ def propagate(ctx, programs, state: LpvGridState, source: Volumes, injected_flux
     return {"iterations": step + 1, "moved": moved_history}
 
 
-def copy_volumes(ctx, src: Volumes, dst: Volumes) -> None:
-    for a, b in zip(src.textures(), dst.textures()):
-        b.write(a.read())
-
-
 def inject_all(ctx, programs, rsm: Rsm, shadows, grids: list, world_color=(0.0, 0.0, 0.0),
-               geometry_volumes=None) -> list:
+               gvs=None) -> list:
     """Inject the RSM VPLs and the world light into a fresh state per cascade (finest first). World light enters
     each cascade through its open border: exact for the coarsest grid, whose border is the scene's; a finer
     cascade assumes the world is visible beyond its border (true outdoors, too bright inside closed rooms)."""
     states = []
     for i, grid in enumerate(grids):
         state = LpvGridState(ctx, grid)
-        gv = geometry_volumes[i] if geometry_volumes else None
+        gv = gvs[i] if gvs else None
         state.injected_flux = inject(ctx, programs, rsm, shadows, state, world_color, gv)
         states.append(state)
     return states
 
 
-def propagate_all(ctx, programs, states: list, geometry_volumes: list, settings: LpvSettings) -> dict:
+def propagate_all(ctx, programs, states: list, gvs: list, settings: LpvSettings) -> dict:
     """Propagate every cascade from its injected light, then each further bounce from what the surfaces absorbed
     and reflect. Without a geometry volume there is nothing to absorb light: one bounce, intensity lookup."""
     stats = []
-    for state, gv in zip(states, geometry_volumes):
+    for state, gv in zip(states, gvs):
         copy_volumes(ctx, state.injected, state.accum)  # the injected light itself lights nearby surfaces
         state.face_flux.clear()
         if gv is not None:
@@ -404,114 +265,6 @@ def propagate_all(ctx, programs, states: list, geometry_volumes: list, settings:
                       "injected_flux": state.injected_flux, "bounces": bounces,
                       "iterations": sum(b["iterations"] for b in bounces)})
     return {"cascades": stats}
-
-
-@dataclass
-class GeometryVolume:
-    """Fuzzy occlusion of one cascade (seed 000 §3.4) and the surface voxels that absorb what it stops."""
-    blocking: object  # RGBA32F 3D texture, LPV size + 1: channel a = blocked fraction of cell c's lower face normal to a
-    fine: Grid  # surface voxels: half the LPV cell, offset by half an LPV cell
-    area: object  # fine voxel textures from voxelize(): projected areas per axis + total area
-    normal: object
-    albedo: object
-
-    def release(self):
-        for t in (self.blocking, self.area, self.normal, self.albedo):
-            t.release()
-
-
-def face_blocking(area: np.ndarray, grid: Grid) -> np.ndarray:
-    """Blocked fraction of every LPV face from surface voxels of half the cell size (fine grid, origin − cell/2).
-
-    The face between cells c − e_a and c gets the blocking potential of seed 000 §3.4, B = Σ A_s·|n_s·a| / s²
-    (clamped to 1), summed over the surfels inside the cell-sized box centred on that face — exactly the eight
-    fine voxels [2c_a, 2c_a+2) along a and [2c_u+1, 2c_u+3) along the other axes. (A box centred on the face,
-    rather than the four corner cells of the classic GV, which average over 2s × 2s and so let a 45° wall block
-    only half of each face it crosses.) Returns (nz+1, ny+1, nx+1, 4), channel a at the index of cell c.
-    """
-    nx, ny, nz = grid.size
-    out = np.zeros((nz + 1, ny + 1, nx + 1, 4), np.float64)
-    s2 = grid.cell ** 2
-    proj = [area[..., a] for a in range(3)]  # fine arrays indexed [z, y, x]
-    # axis x: pairs [2i, 2i+2) along x, [2j+1, 2j+3) along y, [2k+1, 2k+3) along z
-    px = proj[0][1:2 * nz + 1, 1:2 * ny + 1, 0:2 * nx + 2]
-    out[:nz, :ny, :, 0] = px.reshape(nz, 2, ny, 2, nx + 1, 2).sum(axis=(1, 3, 5)) / s2
-    py = proj[1][1:2 * nz + 1, 0:2 * ny + 2, 1:2 * nx + 1]
-    out[:nz, :, :nx, 1] = py.reshape(nz, 2, ny + 1, 2, nx, 2).sum(axis=(1, 3, 5)) / s2
-    pz = proj[2][0:2 * nz + 2, 1:2 * ny + 1, 1:2 * nx + 1]
-    out[:, :ny, :nx, 2] = pz.reshape(nz + 1, 2, ny, 2, nx, 2).sum(axis=(1, 3, 5)) / s2
-    out[..., :3] = np.minimum(out[..., :3], 1.0)
-    return out.astype(np.float32)
-
-
-def geometry_volumes(ctx, programs, scene: Scene, geometry, textures, grids: list) -> list:
-    """Fuzzy-occlusion volumes, one per cascade, from a voxelisation of the whole scene (view-independent).
-
-    The blocking potential of seed 000 §3.4 is evaluated in closed form at the axis directions — B_a, the fraction
-    of a face normal to a that surfaces cover — instead of through a 2-band SH projection, because 2-band SH cannot
-    hold a two-sided blocker (the band-1 terms of |n·ω| vanish, which would leave a full wall blocking at most half
-    the light).
-    """
-    import moderngl
-
-    from .voxelize import voxelize
-
-    out = []
-    for grid in grids:
-        fine = Grid(tuple(np.asarray(grid.origin) - grid.cell / 2), grid.cell / 2, tuple(2 * n + 2 for n in grid.size))
-        vox = voxelize(ctx, programs, scene, geometry, textures, fine)
-        blocking = face_blocking(vox.read()["area"], grid)
-        tex = ctx.texture3d(tuple(n + 1 for n in grid.size), 4, np.ascontiguousarray(blocking).tobytes(), dtype="f4")
-        for t in (tex, vox.area, vox.normal, vox.albedo):
-            t.filter = (moderngl.NEAREST, moderngl.NEAREST)
-        vox.emission.release()
-        out.append(GeometryVolume(tex, fine, vox.area, vox.normal, vox.albedo))
-    return out
-
-
-def absorb(ctx, programs, state: LpvGridState, gv: GeometryVolume, add: bool) -> None:
-    """Front/back irradiance of every surface voxel from the flux occlusion stopped (lpv_absorb.glsl); `add`
-    adds it to the bounce totals instead of starting them."""
-    import moderngl
-
-    size = gv.fine.size
-    for name in ("front", "back", "front_total", "back_total"):
-        if getattr(state, name) is None:
-            t = ctx.texture3d(size, 4, dtype="f4")
-            t.filter = (moderngl.NEAREST, moderngl.NEAREST)
-            setattr(state, name, t)
-    prog = programs.compute("lpv_absorb.glsl", {"MODE_ADD": 1} if add else None)
-    state.face_flux.bind_to_storage_buffer(6)
-    gv.blocking.use(location=0)
-    gv.normal.use(location=1)
-    gv.area.use(location=2)
-    direct._set(prog, "u_geometry", 0)
-    direct._set(prog, "u_voxel_normal", 1)
-    direct._set(prog, "u_voxel_area", 2)
-    direct._set(prog, "u_grid_size", tuple(int(c) for c in state.grid.size))
-    direct._set(prog, "u_cell", float(state.grid.cell))
-    for unit, name in enumerate(("front", "back", "front_total", "back_total")):
-        getattr(state, name).bind_to_image(unit, read=True, write=True)
-    prog.run(*((n + 3) // 4 for n in size))
-
-
-def inject_bounce(ctx, programs, state: LpvGridState, gv: GeometryVolume, bound: float) -> float:
-    """Re-inject the light the surfaces absorbed in the last pass, times their albedo (lpv_bounce.glsl)."""
-    scale = FIXED_RANGE / max(bound, 1e-12)
-    state.accum_ints.clear()
-    prog = programs.compute("lpv_bounce.glsl")
-    for unit, (name, tex) in enumerate((("u_front", state.front), ("u_back", state.back),
-                                        ("u_voxel_normal", gv.normal), ("u_voxel_area", gv.area),
-                                        ("u_voxel_albedo", gv.albedo))):
-        tex.use(location=unit)
-        direct._set(prog, name, unit)
-    direct._set(prog, "u_fine_origin", tuple(float(c) for c in gv.fine.origin))
-    direct._set(prog, "u_fine_size", tuple(gv.fine.size))
-    _grid_uniforms(prog, state.grid)
-    direct._set(prog, "u_fixed_scale", float(scale))
-    state.accum_ints.bind_to_storage_buffer(4)
-    prog.run(*((n + 3) // 4 for n in gv.fine.size))
-    return resolve(ctx, programs, state, scale, state.ping)
 
 
 def lighting(ctx, programs, gbuffer, states: list, gvs: list, settings: LpvSettings):
