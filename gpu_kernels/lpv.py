@@ -135,7 +135,7 @@ def sky_flux_bound(grid: Grid, world_color) -> float:
 
 
 def inject(ctx, programs, rsm: Rsm, shadows, state: LpvGridState, world_color=(0.0, 0.0, 0.0),
-           gv=None) -> float:
+           gv=None, downsample: int = 1) -> float:
     """RSM texels (and world light at the open border) → fixed-point SH sums → state.injected. Returns the
     injected flux (W, sum of RGB)."""
     grid = state.grid
@@ -150,6 +150,7 @@ def inject(ctx, programs, rsm: Rsm, shadows, state: LpvGridState, world_color=(0
     direct._set(prog, "u_rsm_albedo", 2)
     direct._set(prog, "u_rsm_size", rsm.size)
     direct._set(prog, "u_rsm_resolution", int(rsm.resolution))
+    direct._set(prog, "u_downsample", int(downsample))
     direct._set(prog, "u_fixed_scale", float(scale))
     _grid_uniforms(prog, grid)
     shadows.light_ssbo.bind_to_storage_buffer(0)
@@ -157,7 +158,8 @@ def inject(ctx, programs, rsm: Rsm, shadows, state: LpvGridState, world_color=(0
     shadows.polygon_ssbo.bind_to_storage_buffer(2)
     rsm.views_ssbo.bind_to_storage_buffer(3)
     state.accum_ints.bind_to_storage_buffer(4)
-    prog.run((rsm.size[0] + 7) // 8, (rsm.size[1] + 7) // 8, 1)
+    blocks = ((rsm.size[0] + downsample - 1) // downsample, (rsm.size[1] + downsample - 1) // downsample)
+    prog.run((blocks[0] + 7) // 8, (blocks[1] + 7) // 8, 1)
     if sky:
         sky_prog = programs.compute("lpv_sky.glsl")
         _grid_uniforms(sky_prog, grid)
@@ -223,7 +225,7 @@ def propagate(ctx, programs, state: LpvGridState, source: Volumes, injected_flux
 
 
 def inject_all(ctx, programs, rsm: Rsm, shadows, grids: list, world_color=(0.0, 0.0, 0.0),
-               gvs=None) -> list:
+               gvs=None, downsample: int = 1) -> list:
     """Inject the RSM VPLs and the world light into a fresh state per cascade (finest first). World light enters
     each cascade through its open border: exact for the coarsest grid, whose border is the scene's; a finer
     cascade assumes the world is visible beyond its border (true outdoors, too bright inside closed rooms)."""
@@ -231,7 +233,7 @@ def inject_all(ctx, programs, rsm: Rsm, shadows, grids: list, world_color=(0.0, 
     for i, grid in enumerate(grids):
         state = LpvGridState(ctx, grid)
         gv = gvs[i] if gvs else None
-        state.injected_flux = inject(ctx, programs, rsm, shadows, state, world_color, gv)
+        state.injected_flux = inject(ctx, programs, rsm, shadows, state, world_color, gv, downsample)
         states.append(state)
     return states
 

@@ -25,6 +25,7 @@ class LpvSettings:
     resolution: int = 32  # cells along the longest axis of the (finest) grid
     cascades: int = 1  # nested grids, each twice the extent of the last
     rsm_resolution: int = 128  # texels per side of each RSM view (sun: twice that)
+    rsm_downsample: int = 1  # k: inject one VPL per k×k RSM texels, intensity-aware (seed 001); 1, 2 or 4
     max_iterations: int = 64
     epsilon: float = 1e-3  # stop when one step moved less than this fraction of the injected flux
     occlusion: bool = True  # fuzzy occlusion from the geometry volume
@@ -41,6 +42,8 @@ class LpvSettings:
             raise ValueError(f"cascades {self.cascades} out of range 1..4")
         if self.lookup not in ("flux", "intensity"):
             raise ValueError(f"lookup must be 'flux' or 'intensity', not {self.lookup!r}")
+        if self.rsm_downsample not in (1, 2, 4):
+            raise ValueError(f"rsm_downsample must be 1, 2 or 4, not {self.rsm_downsample}")
         if self.bounces < 1 or self.max_iterations < 1 or self.rsm_resolution < 8:
             raise ValueError("bounces and max_iterations must be ≥ 1 and rsm_resolution ≥ 8")
 

@@ -136,9 +136,9 @@ class Pipeline:
         k_gv = (k_geometry, k_materials, k_grids, s.occlusion)
         gvs = cache.run("geometry_volume", k_gv, lambda: lpv.geometry_volumes(
             ctx, programs, scene, geometry, textures, grids) if s.occlusion else [None] * len(grids))
-        k_inject = (k_rsm, k_grids, k_gv, _hash(scene.world))
+        k_inject = (k_rsm, k_grids, k_gv, _hash(scene.world), s.rsm_downsample)
         states = cache.run("lpv_inject", k_inject, lambda: lpv.inject_all(ctx, programs, rsm, shadows, grids,
-                                                                          scene.world.color, gvs))
+                                                                          scene.world.color, gvs, s.rsm_downsample))
         k_prop = (k_inject, k_gv, repr(s))
         stats = cache.run("lpv_propagate", k_prop, lambda: lpv.propagate_all(ctx, programs, states, gvs, s))
         k_light = (k_gbuffer, k_prop)
@@ -158,7 +158,8 @@ class Pipeline:
         vox = cache.run("vct_voxelize", k_vox,
                         lambda: vct.voxelize_scene(ctx, programs, scene, geometry, textures, grid))
         k_inject = (k_vox, k_shadow, levels)
-        faces = cache.run("vct_inject", k_inject, lambda: vct.inject(ctx, programs, vox, shadows, levels))
+        faces = cache.run("vct_inject", k_inject, lambda: vct.inject(ctx, programs, scene, geometry, textures, vox,
+                                                                shadows, levels))
         k_mip = (k_inject, s.anisotropic)
         volumes = cache.run("vct_mipmap", k_mip, lambda: vct.build_volumes(ctx, programs, faces, s.anisotropic))
         k_bounce = (k_mip, world, s.key("bounce"))

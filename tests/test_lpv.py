@@ -170,3 +170,20 @@ def test_world_light_reaches_an_open_floor_and_not_a_closed_sphere(engine):
     inside = r.passes["Diffuse Indirect"][..., 0] * math.pi
     print("inside a closed sphere: mean E / π =", inside.mean() / math.pi)
     assert inside.mean() < 0.25 * math.pi
+
+
+@pytest.mark.parametrize("downsample", [2, 4])
+def test_intensity_aware_rsm_downsampling_keeps_the_flux(engine, downsample):
+    """Clustering k×k RSM texels into one VPL (seed 001) sums their flux: the injected total must not change
+    (float32 sums: 1e-4), and the image may change only by where the merged VPLs sit (means within 10%)."""
+    scene = _sphere_scene()
+    results = []
+    for k in (1, downsample):
+        r = engine.render(scene, RenderSettings("lpv", 64, 48, lpv=lpv.LpvSettings(
+            rsm_downsample=k, bounces=1, max_iterations=16, resolution=16)))
+        results.append(r)
+    fluxes = [r.info["cascades"][0]["injected_flux"] for r in results]
+    means = [float(r.passes["Diffuse Indirect"].mean()) for r in results]
+    print(f"downsample {downsample}: injected {fluxes}, mean Diffuse Indirect {means}")
+    assert fluxes[1] == pytest.approx(fluxes[0], rel=1e-4)
+    assert means[1] == pytest.approx(means[0], rel=0.10)

@@ -12,6 +12,7 @@ uniform sampler2D u_rsm_normal;
 uniform sampler2D u_rsm_albedo;
 uniform ivec2 u_rsm_size;
 uniform int u_rsm_resolution;     // texels per RSM view side
+uniform int u_downsample;         // k: each k×k block of texels becomes one VPL (seed 001 N.5.2, intensity-aware)
 uniform vec3 u_grid_origin;
 uniform float u_grid_cell;
 uniform ivec3 u_grid_size;
@@ -76,14 +77,26 @@ vec3 vpl_flux(RsmView v, vec3 p, vec3 n, vec3 albedo) {
 }
 
 void main() {
-    ivec2 px = ivec2(gl_GlobalInvocationID.xy);
-    if (any(greaterThanEqual(px, u_rsm_size))) return;
-    vec4 pos = texelFetch(u_rsm_position, px, 0);
-    if (pos.w < 0.5) return;
-    RsmView v = rsm_views[int(pos.w - 0.5)];
-    vec3 n = normalize(texelFetch(u_rsm_normal, px, 0).xyz);
-    vec3 albedo = texelFetch(u_rsm_albedo, px, 0).rgb;
-    vec3 flux = vpl_flux(v, pos.xyz, n, albedo);
-    if (max(flux.r, max(flux.g, flux.b)) <= 0.0) return;
-    inject_lambertian(LpvGrid(u_grid_origin, u_grid_cell, u_grid_size), pos.xyz, n, flux);
+    // Intensity-aware clustering (seed 001 N.5.2): a k×k block of RSM texels becomes one VPL with the block's total
+    // flux, at the luminance-weighted mean position and normal — flux is kept exactly, and the VPL sits where the
+    // light is. Blocks never straddle views: tiles are multiples of 16 texels and k divides 16.
+    ivec2 block = ivec2(gl_GlobalInvocationID.xy);
+    if (any(greaterThanEqual(block * u_downsample, u_rsm_size))) return;
+    vec3 flux = vec3(0.0), position = vec3(0.0), normal = vec3(0.0);
+    float weight = 0.0;
+    for (int j = 0; j < u_downsample; ++j)
+        for (int i = 0; i < u_downsample; ++i) {
+            ivec2 px = block * u_downsample + ivec2(i, j);
+            vec4 pos = texelFetch(u_rsm_position, px, 0);
+            if (pos.w < 0.5) continue;
+            vec3 n = normalize(texelFetch(u_rsm_normal, px, 0).xyz);
+            vec3 f = vpl_flux(rsm_views[int(pos.w - 0.5)], pos.xyz, n, texelFetch(u_rsm_albedo, px, 0).rgb);
+            float w = dot(f, vec3(0.2126, 0.7152, 0.0722));  // Rec.709 luminance
+            flux += f;
+            position += w * pos.xyz;
+            normal += w * n;
+            weight += w;
+        }
+    if (weight <= 0.0 || dot(normal, normal) == 0.0) return;
+    inject_lambertian(LpvGrid(u_grid_origin, u_grid_cell, u_grid_size), position / weight, normalize(normal), flux);
 }
