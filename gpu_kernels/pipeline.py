@@ -166,7 +166,8 @@ class Pipeline:
         bounced = cache.run("vct_bounce", k_bounce,
                             lambda: vct.bounce(ctx, programs, vox, faces, volumes, s, world))
         k_trace = (k_gbuffer, k_bounce, s.key("trace"))
-        traced = cache.run("vct_trace", k_trace, lambda: vct.trace(ctx, programs, gbuffer, bounced, s, world))
+        traced = cache.run("vct_trace", k_trace, lambda: vct.trace(ctx, programs, gbuffer, faces, bounced, s,
+                                                                          world))
         return traced["indirect"], k_trace, vct.render_info(faces, bounced, s)
 
     def release(self) -> None:

@@ -8,12 +8,6 @@
 uniform sampler2DShadow u_shadow_atlas;
 uniform vec2 u_atlas_texel;        // 1 / atlas size
 
-// Extra offset (m) of the shadow lookup toward the light. 0 for pixels; VCT injection (vct_inject.glsl) sets one
-// voxel so that a voxel face is not shadowed by the other surfaces inside its own voxel.
-#ifndef SHADOW_TOWARD_LIGHT
-#define SHADOW_TOWARD_LIGHT 0.0
-#endif
-
 // Visibility of world point p from one shadow view with a normal-offset bias and percentage-closer filtering.
 // The offset grows with the shadow texel's world footprint, which removes acne without a hand-tuned constant.
 float view_visibility(int view_index, vec3 p, vec3 geo_n, vec3 to_light) {
@@ -24,8 +18,7 @@ float view_visibility(int view_index, vec3 p, vec3 geo_n, vec3 to_light) {
     float cos_l = clamp(dot(geo_n, to_light), 0.0, 1.0);
     float sin_l = sqrt(max(0.0, 1.0 - cos_l * cos_l));
     // 1.5 texels along the normal, more at grazing angles (slope-scaled), capped.
-    vec3 q = p + geo_n * texel_world * (1.5 + 2.0 * min(sin_l / max(cos_l, 0.05), 8.0))
-             + to_light * SHADOW_TOWARD_LIGHT;
+    vec3 q = p + geo_n * texel_world * (1.5 + 2.0 * min(sin_l / max(cos_l, 0.05), 8.0));
     vec4 clip = v.view_projection * vec4(q, 1.0);
     vec3 ndc = clip.xyz / clip.w;
     if (clip.w <= 0.0) return 1.0;

@@ -24,6 +24,9 @@ uniform float u_max_distance;    // metres; 0 = until the cone leaves the grid
 uniform float u_ao_distance;     // metres; 0 = AO is the sky visibility (transmittance of cones leaving the grid)
 uniform vec3 u_world;            // world (background) radiance, seen through what is left of a cone leaving the grid
 
+uniform sampler3D u_centroid[6]; // vct_inject: per face, xyz = its surface centroid, w = ±coverage (0: no surface)
+#include "vct_arrays.glsl"
+VCT_FETCH6(centroid_face, u_centroid)
 #if defined(MODE_ANISO)
 uniform sampler3D u_volume[6];
 #else
@@ -73,10 +76,13 @@ struct ConeResult {
 // the start offset of 1.5 voxels (× ‖n‖₁) along the normal, and the level is capped at
 // floor(log2(h / (1.5·‖n‖₁·cell))): grazing cones sample finer levels (more, shorter steps) rather than the surface
 // they start from. The level otherwise follows the cone diameter (seed 004 listing 4.1: lod = log2(diameter)).
-ConeResult trace_cone(vec3 p, vec3 n_geo, vec3 d, float tan_half) {
+// Known bias (measured): a capped cone reads a footprint narrower than itself, so a bright area at its centre counts
+// for the whole cone — a 3 m lit square seen from 3 m above came out 35% too bright, a 0.6 m one 20% too dark.
+// Four lateral samples per capped step did not help (+56% on the 3 m square): τ blended across a surface's edge
+// overstates its coverage (Jensen), and more samples across the cone meet more edges.
+ConeResult trace_cone(vec3 p, vec3 o, vec3 n_geo, vec3 d, float tan_half) {
     float n1 = abs(n_geo.x) + abs(n_geo.y) + abs(n_geo.z);
-    float h0 = u_offset * n1 * u_cell;
-    vec3 o = p + n_geo * h0;
+    float h0 = dot(o - p, n_geo);
     float dh = dot(d, n_geo);
     float ao_limit = u_ao_distance > 0.0 ? u_ao_distance : 3.4e38;
     ConeResult r = ConeResult(vec3(0.0), 1.0, false, 1.0);
@@ -117,9 +123,40 @@ void onb(vec3 n, out vec3 t1, out vec3 t2) {
     t2 = vec3(b, s + n.y * n.y * a, -n.y);
 }
 
+// The cone origin: p moved u_offset voxels (× ‖n‖₁) along the normal (see trace_cone), then out of any voxel that
+// holds another surface. A point within a voxel of a wall it stands beside (a floor pixel at an edge, a corner)
+// would otherwise start inside that wall's voxel, and a ray leaving it away from the wall would meet the voxel's
+// far face — the wall's back — as if it still had to cross the wall (the white furnace lost up to 40% of its light
+// next to the box's edges). So for each axis, the voxel holding o and its two neighbours along it are checked for a surface
+// across that axis lying between p's side and o (its position: the centroid of its faces, vct_inject.glsl), and o
+// moves along the axis, to p's side, to at least the centre of the voxel next to it: there the trilinear support
+// of the first sample no longer reaches the wall's voxel. Measured (anisotropic white furnace, 32³): 92.7% → 94.8% of
+// the exact value overall, 60% → 87% within 2 cm of the box's edges.
+vec3 cone_origin(vec3 p, vec3 n_geo) {
+    float n1 = abs(n_geo.x) + abs(n_geo.y) + abs(n_geo.z);
+    vec3 o = p + n_geo * (u_offset * n1 * u_cell);
+    ivec3 v0 = ivec3(floor((o - u_grid_origin) / u_cell));
+    for (int b = 0; b < 3; ++b) {
+        for (int k = -1; k <= 1; ++k) {   // the voxel holding o and its two neighbours along b
+            ivec3 v = v0;
+            v[b] += k;
+            if (any(lessThan(v, ivec3(0))) || any(greaterThanEqual(v, u_grid_size))) continue;
+            vec4 cp = centroid_face(2 * b, v, 0), cm = centroid_face(2 * b + 1, v, 0);
+            if (cp.w == 0.0 && cm.w == 0.0) continue;
+            float s = cp.w != 0.0 && cm.w != 0.0 ? 0.5 * (cp[b] + cm[b]) : (cp.w != 0.0 ? cp[b] : cm[b]);
+            float side = p[b] - s;
+            if (side == 0.0 || (k < 0 && side < 0.0) || (k > 0 && side > 0.0)) continue;   // a surface beyond o
+            float target = u_grid_origin[b] + (float(v[b]) + (side > 0.0 ? 1.5 : -0.5)) * u_cell;
+            o[b] = side > 0.0 ? max(o[b], target) : min(o[b], target);
+        }
+    }
+    return o;
+}
+
 // Irradiance E at p over the hemisphere of n (rgb), and the cosine-weighted AO / sky visibility (a, in [0, 1]):
 // E = Σ_k w_k·(L_k + T_k·L_world if cone k left the grid), with Σ_k w_k = π (vct.cone_table).
 vec4 gather_irradiance(vec3 p, vec3 n, vec3 n_geo) {
+    vec3 o = cone_origin(p, n_geo);
     vec3 t1, t2;
     onb(n, t1, t2);
     vec3 e = vec3(0.0);
@@ -127,7 +164,7 @@ vec4 gather_irradiance(vec3 p, vec3 n, vec3 n_geo) {
     for (int k = 0; k < u_cone_count; ++k) {
         vec4 c = u_cones[k];
         vec3 d = normalize(t1 * c.x + t2 * c.y + n * c.z);
-        ConeResult r = trace_cone(p, n_geo, d, u_cone_tan[k]);
+        ConeResult r = trace_cone(p, o, n_geo, d, u_cone_tan[k]);
         e += c.w * (r.radiance + (r.exited ? r.transmittance * u_world : vec3(0.0)));
         ao += c.w * r.ao;
     }

@@ -5,16 +5,20 @@
 // Why τ and not the usual opacity α = 1 − e^−τ: trilinear filtering and the cone's discrete steps then integrate
 // τ exactly — a hat-shaped τ profile sampled every half texel sums to the texel's τ for any phase — so a wall one
 // voxel thick stops exactly as much of a cone as it should, wherever the samples fall. Filtering α instead smears
-// an opaque wall into partially transparent samples whose product lets ~20% of a cone through (measured in the
-// white furnace: 12% of the light lost with α, see tests/test_vct.py). And τ·S interpolates to the τ-weighted mean
-// radiance, the source function of the filtered medium. An opaque voxel gets τ_max = −ln(MIN_TRANSMITTANCE): it
-// ends a cone, as an opaque voxel should (vct_common.glsl).
+// an opaque wall into partially transparent samples whose product lets part of a cone through (measured, the
+// anisotropic white furnace at 32³: 87.6% of the exact light with α stored, 92.4% with τ, all else equal; the
+// isotropic one 39.5% with the α-averaged mips, 99.9% with the σ-average below). And τ·S interpolates to the
+// τ-weighted mean radiance, the source function of the filtered medium. An opaque voxel gets
+// τ_max = −ln(MIN_TRANSMITTANCE): it ends a cone, as an opaque voxel should (vct_common.glsl).
 //
 // MODE_BASE: level 0 from the six face radiances of vct_inject / vct_bounce (rgb = L_g, a = α_g, g = outward face
 //   normal +x, −x, +y, −y, +z, −z), τ = −ln(1 − α) capped at τ_max.
-//   isotropic: α = max_g α_g (= the voxelizer's opacity), S = the brightest face, per channel. One value must serve
-//     every direction; the brightest face keeps a wall lit on one side as bright as it is (the mean would halve it,
-//     since most walls are dark on their back), at the price of the classic VCT leak: the back side glows too.
+//   isotropic: α = max_g α_g (= the voxelizer's opacity); S = the coverage-weighted mean over the three axes of the
+//     brighter of the axis' two faces (per channel). One value must serve every direction. Taking the brighter side
+//     keeps a wall lit on one side as bright as it is (the mean of both sides would halve it, since most walls are
+//     dark on their back), at the price of the classic VCT leak: the back side glows too. Weighting the axes by
+//     their projected areas keeps a voxel's few lit pixels of box top from lighting its whole side (taking the
+//     brightest face overall made Cornell's Diffuse Indirect 2× too bright).
 //   MODE_ANISO: volume f (direction of travel +x, −x, ...) holds the face a ray travelling that way sees, i.e. the
 //     face whose normal points back at it: g = f ^ 1 (Crassin et al. 2011's directional voxels, down to level 0).
 // MODE_DOWN: level l from level l − 1 (sizes are multiples of 2^max_level, so every parent has 8 children).
@@ -23,32 +27,41 @@
 //     wall that fills one layer of children keeps its optical depth (tests/test_vct.py).
 //   MODE_ANISO: for direction f, the 4 columns of 2 children along f's axis are composited front to back in the
 //     direction of travel, C = C_front + (1 − α_front)·C_back, α = α_front + (1 − α_front)·α_back (premultiplied
-//     C = α·S), the columns averaged in (C, α), and stored back as τ = −ln(1 − α), τ·S = τ·C/α. A wall one voxel
-//     thick stays opaque at every level for rays crossing it (Crassin et al. 2011).
+//     C = α·S), the columns averaged in (C, α) (see below why α and not τ), and stored back as τ = −ln(1 − α),
+//     τ·S = τ·C/α. A wall one voxel thick stays opaque at every level for rays crossing it (Crassin et al. 2011).
 // MODE_READ: copy one level of u_src[0] into a buffer (tests and statistics; moderngl reads level 0 only).
-// MODE_FLUX: per row (y, z) of the face textures, Σ_x Σ_g α_g·L_g (rgb) and the occupied voxels (a), for the
-//   flux statistics of vct.face_flux (no float atomics: rows are summed here, rows on the CPU).
+// MODE_FLUX: per row (y, z) of the face textures, Σ_x Σ_g α_g·L_g (rgb), the occupied voxels and the faces that
+//   caught no raster sample, for the statistics of vct.face_flux (no float atomics: rows summed here and on the CPU).
 uniform ivec3 u_dst_size;   // size of the level written (or read)
 uniform int u_level;
 
 #if defined(MODE_FLUX)
 layout(local_size_x = 8, local_size_y = 8) in;
 uniform sampler3D u_src[6];
-layout(std430, binding = 0) writeonly buffer Out { vec4 rows[]; };
+uniform sampler3D u_centroid[6];
+uniform bool u_has_centroids;
+#include "vct_arrays.glsl"
+VCT_FETCH6(src_face, u_src)
+VCT_FETCH6(centroid_face, u_centroid)
+layout(std430, binding = 0) writeonly buffer Out { vec4 rows[]; };   // 2 per row: (Σ α·L, occupied), (missed, 0…)
 void main() {
     ivec2 yz = ivec2(gl_GlobalInvocationID.xy);
     if (yz.x >= u_dst_size.y || yz.y >= u_dst_size.z) return;
     vec4 sum = vec4(0.0);
+    float missed = 0.0;
     for (int x = 0; x < u_dst_size.x; ++x) {
         float occupied = 0.0;
         for (int g = 0; g < 6; ++g) {
-            vec4 f = texelFetch(u_src[g], ivec3(x, yz), 0);
+            vec4 f = src_face(g, ivec3(x, yz), 0);
             sum.rgb += f.a * f.rgb;
             occupied = max(occupied, float(f.a > 0.0));
+            if (u_has_centroids && f.a > 0.0 && centroid_face(g, ivec3(x, yz), 0).w < 0.0) missed += 1.0;
         }
         sum.a += occupied;
     }
-    rows[yz.y * u_dst_size.y + yz.x] = sum;
+    int row = yz.y * u_dst_size.y + yz.x;
+    rows[2 * row] = sum;
+    rows[2 * row + 1] = vec4(missed, 0.0, 0.0, 0.0);
 }
 #elif defined(MODE_READ)
 layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
@@ -78,33 +91,42 @@ vec4 stored(vec3 radiance, float alpha) {
 #endif
 uniform sampler3D u_src[6];   // MODE_BASE: the six face textures; MODE_DOWN: the volumes at level u_level − 1
 layout(rgba32f, binding = 0) uniform writeonly image3D u_dst[VOLUMES];
+#include "vct_arrays.glsl"
+VCT_FETCH6(src_face, u_src)
+#if defined(MODE_ANISO)
+VCT_STORE6(store_dst, u_dst)
+#else
+void store_dst(int i, ivec3 c, vec4 x) { imageStore(u_dst[0], c, x); }
+#endif
 
 #if defined(MODE_BASE)
 void main() {
     ivec3 v = ivec3(gl_GlobalInvocationID);
     if (any(greaterThanEqual(v, u_dst_size))) return;
     vec4 face[6];
-    for (int g = 0; g < 6; ++g) face[g] = texelFetch(u_src[g], v, 0);
+    for (int g = 0; g < 6; ++g) face[g] = src_face(g, v, 0);
 #if defined(MODE_ANISO)
     for (int f = 0; f < 6; ++f) {
         vec4 s = face[f ^ 1];
-        imageStore(u_dst[f], v, stored(s.rgb, s.a));
+        store_dst(f, v, stored(s.rgb, s.a));
     }
 #else
-    float alpha = 0.0;
+    float alpha = 0.0, weight = 0.0;
     vec3 radiance = vec3(0.0);
-    for (int g = 0; g < 6; ++g) {
-        if (face[g].a > 0.0) radiance = max(radiance, face[g].rgb);
-        alpha = max(alpha, face[g].a);
+    for (int axis = 0; axis < 3; ++axis) {
+        vec4 plus = face[2 * axis], minus = face[2 * axis + 1];   // same coverage: one projected area per axis
+        radiance += plus.a * max(plus.rgb, minus.rgb);
+        weight += plus.a;
+        alpha = max(alpha, plus.a);
     }
-    imageStore(u_dst[0], v, stored(radiance, alpha));
+    imageStore(u_dst[0], v, stored(weight > 0.0 ? radiance / weight : vec3(0.0), alpha));
 #endif
 }
 #endif
 
 #if defined(MODE_DOWN)
 vec4 child(int f, ivec3 c) {
-    return texelFetch(u_src[f], c, u_level - 1);
+    return src_face(f, c, u_level - 1);
 }
 
 // Stored (τ·S, τ) → premultiplied (α·S, α).
@@ -124,7 +146,7 @@ void main() {
         step[axis] = 1;
         // Travelling +axis, the child with the lower coordinate is in front; travelling −axis, the higher one.
         bool forward = (f & 1) == 0;
-        vec4 sum = vec4(0.0);
+        vec4 sum = vec4(0.0);   // premultiplied (α·S, α), composited per column
         for (int j = 0; j < 2; ++j)
             for (int i = 0; i < 2; ++i) {
                 ivec3 c = base;
@@ -135,8 +157,14 @@ void main() {
                 vec4 front = forward ? lo : hi, back = forward ? hi : lo;
                 sum += front + (1.0 - front.a) * back;
             }
+        // The mean over the columns of α (the fraction of rays crossing the parent along f that are stopped), not
+        // of τ: averaging τ enlarges a small bright object to the whole parent (Cornell's box tops, 6.5 W/(m²·sr),
+        // took over their coarse texels: Cornell / courtyard Diffuse Indirect came out 15% / 8% brighter at 8
+        // bounces, measured), at the price of some light through corners, where a coarse texel is half outside a
+        // room (white furnace 5% low).
         sum *= 0.25;
-        imageStore(u_dst[f], v, sum.a > 0.0 ? stored(sum.rgb / sum.a, sum.a) : vec4(0.0));
+        float tau = depth_of(sum.a);
+        store_dst(f, v, sum.a > 0.0 ? vec4(tau * sum.rgb / sum.a, tau) : vec4(0.0));
     }
 #else
     vec4 sum = vec4(0.0);

@@ -1,0 +1,105 @@
+"""VCT cone passes (seed 004 §4.5.2): the gathers at voxel faces (vct_bounce) and at G-buffer pixels (vct_trace),
+plus readbacks for tests and statistics. Data types, settings and the injection / mipmap passes are in vct.py."""
+from __future__ import annotations
+
+import numpy as np
+
+from . import direct
+from .grid import Grid
+from .vct import MAX_CONES, ConeVolumes, Faces, VctSettings, _dispatch, _grid_uniforms, _texture3d, _units, \
+    build_volumes, cone_table, face_flux
+
+
+def _cone_uniforms(prog, grid: Grid, levels: int, s: VctSettings, world) -> None:
+    """Grid, cone table and trace settings of vct_common.glsl."""
+    dirs, weights, tans = cone_table(s.diffuse_cones, s.diffuse_aperture)
+    n = len(weights)
+    cones = np.zeros((MAX_CONES, 4), np.float32)
+    cones[:n, :3], cones[:n, 3] = dirs, weights
+    tan = np.zeros(MAX_CONES, np.float32)
+    tan[:n] = tans
+    if "u_cones" in prog:
+        prog["u_cones"].write(cones.tobytes())
+    if "u_cone_tan" in prog:
+        prog["u_cone_tan"].write(tan.tobytes())
+    _grid_uniforms(prog, grid, levels)
+    for name, value in (("u_cone_count", n), ("u_step", float(s.step_multiplier)),
+                        ("u_offset", float(s.start_offset)), ("u_max_distance", float(s.max_distance)),
+                        ("u_ao_distance", float(s.ao_distance)), ("u_world", tuple(float(c) for c in world[:3]))):
+        direct._set(prog, name, value)
+
+
+def bounce(ctx, programs, vox, direct_faces: Faces, volumes: ConeVolumes, s: VctSettings, world) -> ConeVolumes:
+    """bounces − 1 gathers at the voxel faces (vct_bounce.glsl), each followed by a re-mip. Returns the volumes
+    the final gather reads (a non-owning view of `volumes` when bounces = 1); `bounce_stats` lists the flux the
+    faces carry after each bounce (bounce 1 = direct light reflected once)."""
+    stats = [{"bounce": 1, "flux": direct_faces.flux}]
+    if s.bounces <= 1:
+        return ConeVolumes(volumes.textures, volumes.grid, volumes.levels, volumes.anisotropic, owned=False,
+                           bounce_stats=stats)
+    grid = direct_faces.grid
+    faces = Faces([_texture3d(ctx, grid.size, zero=True) for _ in range(6)], grid, direct_faces.levels)
+    prog = programs.compute("vct_bounce.glsl", {"MODE_ANISO": None} if volumes.anisotropic else None)
+    own, source = None, volumes
+    for b in range(2, s.bounces + 1):
+        unit = _units(prog, "u_volume", source.textures, 0)
+        unit = _units(prog, "u_direct", direct_faces.textures, unit)
+        unit = _units(prog, "u_centroid", direct_faces.centroids, unit)
+        _units(prog, "u_albedo", [vox.albedo], unit)
+        _cone_uniforms(prog, grid, volumes.levels, s, world)
+        for i, t in enumerate(faces.textures):
+            t.bind_to_image(i, read=False, write=True)
+        _dispatch(prog, grid.size)
+        ctx.memory_barrier()
+        own = source = build_volumes(ctx, programs, faces, volumes.anisotropic, into=own)
+        stats.append({"bounce": b, "flux": face_flux(ctx, programs, faces)[0]})
+    own.faces, own.bounce_stats = faces, stats
+    return own
+
+
+def trace(ctx, programs, gbuffer, faces: Faces, volumes: ConeVolumes, s: VctSettings, world) -> dict:
+    """Diffuse cones per G-buffer pixel (vct_trace.glsl): {'indirect': RGBA32F texture, rgb = Diffuse Indirect
+    (irradiance/π), a = voxel AO}."""
+    w, h = gbuffer.size
+    out = ctx.texture((w, h), 4, dtype="f4")
+    prog = programs.compute("vct_trace.glsl", {"MODE_ANISO": None} if volumes.anisotropic else None)
+    unit = _units(prog, "u_volume", volumes.textures, 0)
+    unit = _units(prog, "u_centroid", faces.centroids, unit)
+    for name in ("position", "normal", "geo_normal"):
+        unit = _units(prog, f"u_{name}", [gbuffer.textures[name]], unit)
+    _cone_uniforms(prog, volumes.grid, volumes.levels, s, world)
+    direct._set(prog, "u_image_size", (w, h))
+    out.bind_to_image(0, read=False, write=True)
+    prog.run((w + 7) // 8, (h + 7) // 8, 1)
+    return {"indirect": out}
+
+
+def read_ao(texture) -> np.ndarray:
+    """Voxel AO (H, W) from vct_trace's texture, rows top-to-bottom."""
+    return direct.read_texture(texture, 4)[..., 3]
+
+
+def read_level(ctx, programs, texture, grid: Grid, level: int) -> np.ndarray:
+    """One mip level of a volume texture as (nz, ny, nx, 4) float32 (vct_mipmap.glsl MODE_READ)."""
+    nx, ny, nz = (int(n) >> level for n in grid.size)
+    out = ctx.buffer(reserve=nx * ny * nz * 16)
+    try:
+        prog = programs.compute("vct_mipmap.glsl", {"MODE_READ": None})
+        _units(prog, "u_src", [texture], 0)
+        direct._set(prog, "u_dst_size", (nx, ny, nz))
+        direct._set(prog, "u_level", level)
+        out.bind_to_storage_buffer(0)
+        _dispatch(prog, (nx, ny, nz))
+        ctx.memory_barrier()
+        return np.frombuffer(out.read(), np.float32).reshape(nz, ny, nx, 4).copy()
+    finally:
+        out.release()
+
+
+def render_info(faces: Faces, volumes: ConeVolumes, s: VctSettings) -> dict:
+    """RenderResult.info for method 'vct': grid, levels, occupancy, flux per bounce."""
+    g = faces.grid
+    return {"grid": list(g.size), "cell": g.cell, "origin": list(g.origin), "levels": faces.levels,
+            "anisotropic": s.anisotropic, "occupied_voxels": faces.occupied, "faces_without_samples": faces.missed,
+            "cones": s.diffuse_cones,
+            "bounces": [dict(b) for b in (volumes.bounce_stats or [])]}
