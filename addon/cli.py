@@ -93,19 +93,21 @@ def load_scene(path: str, resolution=None):
     return scene
 
 
-def parse_method_options(pairs) -> dict:
-    """`--lpv key=value ...` → LpvSettings keyword arguments, typed like the dataclass fields."""
+def parse_method_options(pairs, settings_cls=None, flag: str = "--lpv") -> dict:
+    """`--lpv key=value ...` (or `--vct ...`) → keyword arguments of the method's settings dataclass, typed like
+    its fields."""
     import dataclasses
 
-    from ..gpu_kernels.lpv import LpvSettings
+    if settings_cls is None:
+        from ..gpu_kernels.lpv import LpvSettings as settings_cls
 
-    fields = {f.name: f for f in dataclasses.fields(LpvSettings)}
+    fields = {f.name: f for f in dataclasses.fields(settings_cls)}
     out = {}
     for pair in pairs or ():
         key, sep, value = pair.partition("=")
         if not sep or key not in fields:
-            raise CliError(f"--lpv {pair}: expected KEY=VALUE with KEY one of {', '.join(fields)}")
-        default = getattr(LpvSettings(), key)
+            raise CliError(f"{flag} {pair}: expected KEY=VALUE with KEY one of {', '.join(fields)}")
+        default = getattr(settings_cls(), key)
         try:
             if isinstance(default, bool):
                 if value.lower() not in ("1", "0", "true", "false", "yes", "no", "on", "off"):
@@ -113,23 +115,31 @@ def parse_method_options(pairs) -> dict:
                 out[key] = value.lower() in ("1", "true", "yes", "on")
             else:
                 out[key] = type(default)(value)
-        except ValueError:
-            raise CliError(f"--lpv {pair}: {value!r} is not a valid {type(default).__name__}") from None
+        except (TypeError, ValueError):
+            raise CliError(f"{flag} {pair}: {value!r} is not a valid {type(default).__name__}") from None
     return out
 
 
-def render_ours(scene, method: str, lpv_options: dict | None = None):
+def vct_options(pairs) -> dict:
+    from ..gpu_kernels.vct import VctSettings
+
+    return parse_method_options(pairs, VctSettings, "--vct")
+
+
+def render_ours(scene, method: str, lpv_options: dict | None = None, vct_settings: dict | None = None):
     from ..gpu_kernels.engine import get_engine
     from ..gpu_kernels.gpu_context import GpuUnavailableError
     from ..gpu_kernels.lpv import LpvSettings
     from ..gpu_kernels.pipeline import RenderSettings, SceneError
+    from ..gpu_kernels.vct import VctSettings
 
     try:
         lpv_settings = LpvSettings(**(lpv_options or {}))
+        vct = VctSettings(**(vct_settings or {}))
     except ValueError as exc:
-        raise CliError(f"--lpv: {exc}") from None
+        raise CliError(f"method settings: {exc}") from None
     settings = RenderSettings(method=method, width=scene.resolution[0], height=scene.resolution[1],
-                              lpv=lpv_settings)
+                              lpv=lpv_settings, vct=vct)
     try:
         return get_engine().render(scene, settings)
     except (SceneError, NotImplementedError, GpuUnavailableError) as exc:
@@ -143,7 +153,7 @@ def cmd_render(args) -> dict:
         check_blend_path(args.scene)
         out = check_output_path(os.path.splitext(os.path.abspath(args.scene))[0] + f"_bounce_{args.method}.exr", ".exr")
     scene = load_scene(args.scene, tuple(args.res) if args.res else None)
-    result = render_ours(scene, args.method, parse_method_options(args.lpv))
+    result = render_ours(scene, args.method, parse_method_options(args.lpv), vct_options(args.vct))
     from ..gpu_kernels import exr_io
 
     write_output(exr_io.write_passes, out, result.passes)
@@ -168,14 +178,15 @@ def format_timings(timings: dict) -> str:
     return "\n".join(lines)
 
 
-def compare(scene, method: str, samples: int, bounces: int = 8, progress=_progress, lpv_options=None) -> dict:
+def compare(scene, method: str, samples: int, bounces: int = 8, progress=_progress, lpv_options=None,
+            vct_settings=None) -> dict:
     """Render ours and the (cached) two-seed Cycles reference of the currently open scene; return the errors."""
     import numpy as np
 
     from ..gpu_kernels import metrics
     from .cycles_reference import ReferenceSettings, render_reference
 
-    result = render_ours(scene, method, lpv_options)
+    result = render_ours(scene, method, lpv_options, vct_settings)
     ref_settings = ReferenceSettings(scene.resolution[0], scene.resolution[1], samples=samples, bounces=bounces)
     ref = render_reference(scene.content_hash(), ref_settings, progress=progress)
     ours = result.passes
@@ -209,7 +220,8 @@ def cmd_compare(args) -> dict:
     heatmap = check_output_path(args.heatmap, ".png") if args.heatmap else None
     scene = load_scene(args.scene, tuple(args.res) if args.res else None)
     report, result, ref, mask = compare(scene, args.method, args.samples, args.bounces,
-                                        lpv_options=parse_method_options(args.lpv))
+                                        lpv_options=parse_method_options(args.lpv),
+                                        vct_settings=vct_options(args.vct))
     if heatmap:
         from ..gpu_kernels import exr_io, metrics
 
@@ -254,6 +266,7 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--out", help="output .exr (default: next to the .blend)")
     r.add_argument("--json", action="store_true", help="print one JSON object as the last stdout line")
     r.add_argument("--lpv", nargs="+", metavar="KEY=VALUE", help="LPV settings, e.g. bounces=4 resolution=32")
+    r.add_argument("--vct", nargs="+", metavar="KEY=VALUE", help="VCT settings, e.g. bounces=4 resolution=64")
     r.set_defaults(func=cmd_render)
     c = sub.add_parser("compare", help="render and compare with a two-seed Cycles reference (cached)")
     c.add_argument("scene")
@@ -264,6 +277,7 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--json", action="store_true")
     c.add_argument("--heatmap", help="write a per-pixel relative error heat map (PNG)")
     c.add_argument("--lpv", nargs="+", metavar="KEY=VALUE", help="LPV settings, e.g. bounces=4 resolution=32")
+    c.add_argument("--vct", nargs="+", metavar="KEY=VALUE", help="VCT settings, e.g. bounces=4 resolution=64")
     c.set_defaults(func=cmd_compare)
     return parser
 

@@ -260,3 +260,30 @@ def test_compare_json_heatmap_and_cache(env, blends, tmp_path):
     inp.close()
     assert (spec.width, spec.height, spec.nchannels) == (48, 36, 3)
     assert sorted(os.listdir(tmp_path)) == ["H.png"], "temporary files left behind"
+
+
+@pytest.mark.parametrize("flag, pair, fragment", [
+    ("--lpv", "bogus=1", "expected KEY=VALUE"),
+    ("--lpv", "bounces=x", "not a valid int"),
+    ("--lpv", "resolution=2", "out of range"),
+    ("--vct", "bounces=x", "not a valid int"),
+    ("--vct", "nokey", "expected KEY=VALUE"),
+])
+def test_bad_method_settings(env, blends, tmp_path, flag, pair, fragment):
+    out = tmp_path / "o.exr"
+    before = snapshot(blends, tmp_path)
+    method = flag[2:]
+    proc = run(env, "render", blends / "cornell.blend", "--res", 16, 12, "--method", method, flag, pair,
+               "--out", out)
+    assert_bad_input(proc, fragment)
+    assert not out.exists() and snapshot(blends, tmp_path) == before
+
+
+def test_method_settings_reach_the_renderer(env, blends, tmp_path):
+    out = tmp_path / "o.exr"
+    proc = run(env, "render", blends / "cornell.blend", "--res", 32, 24, "--method", "lpv", "--lpv", "resolution=8",
+               "bounces=1", "--out", out, "--json")
+    assert proc.returncode == 0, describe(proc)
+    report = json.loads(proc.stdout.strip().splitlines()[-1])
+    cascade = report["info"]["cascades"][0]
+    assert max(cascade["cells"]) == 8 and len(cascade["bounces"]) == 1
