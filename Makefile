@@ -10,7 +10,7 @@ APT_PACKAGES := libx11-6 libxi6 libxfixes3 libxrender1 libxkbcommon0 libsm6 libi
                 libegl1 libegl-mesa0 libgl1-mesa-dri
 STAMP := $(VENV)/.setup-done
 
-.PHONY: setup demo test package clean system-libs
+.PHONY: setup demo test bench package clean system-libs
 
 setup: $(STAMP)
 
@@ -36,6 +36,17 @@ demo: setup
 
 test: setup
 	$(PY) -m pytest -q
+
+# The committed benchmark (benchmarks/results/<renderer>/): example scenes at 320x240 against Cycles (± OIDN) and
+# EEVEE, incremental updates, scaling; its quality table becomes the one automatic quality reads (addon/).
+BENCH_SCENES = cornell spot_room courtyard
+BENCH_OUT ?= benchmarks/results/llvmpipe
+bench: setup
+	$(PY) examples/build_examples.py out/ex $(BENCH_SCENES)
+	$(VENV)/bin/bounce-gi bench $(BENCH_SCENES:%=out/ex/%.blend) --res 320 240 --out $(BENCH_OUT)
+	$(VENV)/bin/bounce-gi bench out/ex/cornell.blend --incremental --res 320 240 --out $(BENCH_OUT)
+	$(VENV)/bin/bounce-gi bench --scaling > $(BENCH_OUT)/scaling.md
+	cp $(BENCH_OUT)/quality_front.json addon/quality_front.json
 
 package: setup
 	$(PY) tools/package.py

@@ -146,7 +146,40 @@ def render_ours(scene, method: str, lpv_options: dict | None = None, vct_setting
         raise CliError(str(exc)) from None
 
 
+def auto_quality(args) -> dict | None:
+    """--budget-ms / --target-error: choose method and settings from the measured table (addon/quality.py);
+    fills args.method, args.lpv, args.vct and returns what to report, or None when neither was given."""
+    if args.budget_ms is None and args.target_error is None:
+        return None
+    from .quality import QualityError, choose, load_table
+
+    if args.lpv or args.vct:
+        raise CliError("--budget-ms/--target-error choose the method's settings; leave out --lpv/--vct")
+    try:
+        table = load_table()
+        choice = choose(table, args.budget_ms, args.target_error, args.method)
+    except QualityError as exc:
+        raise CliError(str(exc)) from None
+    args.method = choice.method
+    import dataclasses
+
+    from ..gpu_kernels.lpv import LpvSettings
+    from ..gpu_kernels.vct import VctSettings
+
+    cls = {"lpv": LpvSettings, "vct": VctSettings}.get(choice.method)
+    known = {f.name for f in dataclasses.fields(cls)} if cls else set()
+    pairs = [f"{k}={v}" for k, v in choice.settings.items() if k in known]  # a newer/older table's extra keys
+    args.lpv, args.vct = (pairs, None) if choice.method == "lpv" else (None, pairs) if choice.method == "vct" \
+        else (None, None)
+    return {"method": choice.method, "settings": choice.settings, "measured_seconds": choice.seconds,
+            "measured_rel_l1": choice.rel_l1, "message": choice.describe(table)}
+
+
 def cmd_render(args) -> dict:
+    quality = auto_quality(args)
+    args.method = args.method or "none"
+    if quality and not args.json:
+        print(quality["message"])
     if args.out:
         out = check_output_path(args.out, ".exr")
     else:
@@ -161,6 +194,8 @@ def cmd_render(args) -> dict:
               "seconds": {k: round(v, 6) for k, v in result.timings.items()}, "skipped": result.skipped,
               "info": result.info,
               "scene": result.statistics, "warnings": result.warnings, "output": out}
+    if quality:
+        report["quality"] = quality
     if not args.json:
         print(format_timings(result.timings))
         for w in result.warnings:
@@ -247,6 +282,38 @@ def format_compare(report: dict) -> str:
     return "\n".join(lines)
 
 
+def cmd_bench(args) -> dict:
+    """Time and error of our settings vs Cycles (± OIDN) and EEVEE; or --incremental / --scaling."""
+    from .bench import check_out_dir, format_bench, run_bench
+
+    if args.scaling:
+        from .bench_scaling import format_scaling, run_scaling
+
+        report = {"scaling": run_scaling(args.quick, _progress)}
+        if not args.json:
+            print(format_scaling(report["scaling"]))
+        return report
+    if not args.scenes:
+        raise CliError("bench needs at least one .blend (or --scaling)")
+    if args.incremental:
+        from .bench_incremental import format_incremental, run_incremental
+
+        paths = [check_blend_path(p) for p in args.scenes]
+        report = {"incremental": [run_incremental(p, args.res, ("none", "lpv", "vct"), _progress,
+                                                  1 if args.quick else 3) for p in paths]}
+        if args.out:
+            text = "".join(format_incremental(e) for e in report["incremental"])
+            write_output(lambda path, t: open(path, "w").write(t),
+                         os.path.join(check_out_dir(args.out), "incremental.md"), text)
+        if not args.json:
+            print("".join(format_incremental(e) for e in report["incremental"]))
+        return report
+    report = run_bench(args.scenes, args.quick, args.res, args.out, _progress, eevee=not args.no_eevee)
+    if not args.json:
+        print(format_bench(report))
+    return report
+
+
 class _ArgumentParser(argparse.ArgumentParser):
     """argparse, but a usage error is one line on stderr and exit code 2 like every other bad input."""
 
@@ -261,9 +328,13 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True)
     r = sub.add_parser("render", help="render a .blend from its scene camera into a multi-layer EXR")
     r.add_argument("scene")
-    r.add_argument("--method", choices=METHODS, default="none")
+    r.add_argument("--method", choices=METHODS, help="default: none (with --budget-ms/--target-error: chosen)")
     r.add_argument("--res", nargs=2, type=int, metavar=("W", "H"))
     r.add_argument("--out", help="output .exr (default: next to the .blend)")
+    r.add_argument("--budget-ms", type=float, metavar="MS",
+                   help="choose method and settings: the most accurate measured to fit this frame time")
+    r.add_argument("--target-error", type=float, metavar="E",
+                   help="choose method and settings: the fastest measured to reach this Combined rel-L1")
     r.add_argument("--json", action="store_true", help="print one JSON object as the last stdout line")
     r.add_argument("--lpv", nargs="+", metavar="KEY=VALUE", help="LPV settings, e.g. bounces=4 resolution=32")
     r.add_argument("--vct", nargs="+", metavar="KEY=VALUE", help="VCT settings, e.g. bounces=4 resolution=64")
@@ -279,6 +350,16 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--lpv", nargs="+", metavar="KEY=VALUE", help="LPV settings, e.g. bounces=4 resolution=32")
     c.add_argument("--vct", nargs="+", metavar="KEY=VALUE", help="VCT settings, e.g. bounces=4 resolution=64")
     c.set_defaults(func=cmd_compare)
+    b = sub.add_parser("bench", help="time vs error of our settings, Cycles (± OIDN) and EEVEE; plots, summary.md")
+    b.add_argument("scenes", nargs="*", metavar="SCENE")
+    b.add_argument("--quick", action="store_true", help="few settings, 96x72, 64-spp reference, one timed run")
+    b.add_argument("--res", nargs=2, type=int, metavar=("W", "H"))
+    b.add_argument("--out", help="directory for plots, summary.md, quality_front.json (default: ./bounce-gi-bench)")
+    b.add_argument("--json", action="store_true")
+    b.add_argument("--incremental", action="store_true", help="time updates by kind of edit in one engine")
+    b.add_argument("--scaling", action="store_true", help="time against triangles, grid size and resolution")
+    b.add_argument("--no-eevee", action="store_true", help="skip the EEVEE peer (minutes on a software GL)")
+    b.set_defaults(func=cmd_bench)
     return parser
 
 

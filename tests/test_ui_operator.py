@@ -151,6 +151,15 @@ def test_render_preview_end_to_end(tmp_path):
         report = preview.finish_render(pending, timeout=120)
         print("plain", report.width, report.height, tuple(img.size))
         assert tuple(img.size) == (16, 12) and (report.width, report.height) == (16, 12)
+
+        # A time budget picks the method from the committed quality table: with an unlimited budget, the most
+        # accurate entry; the panel's report says what was chosen.
+        from bounce_gi.addon.quality import load_table
+        best = min(load_table()["entries"], key=lambda e: e["rel_l1"])
+        scene.bounce_gi.use_time_budget, scene.bounce_gi.time_budget_ms = True, 1e9
+        report = preview.finish_render(preview.start_render(scene, bpy.context.evaluated_depsgraph_get()), 300)
+        print("budget", report.method, report.quality)
+        assert report.method == best["method"] and report.quality.startswith("chose " + best["label"])
     """)
     assert "CASE OK" in out
 

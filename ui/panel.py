@@ -28,7 +28,12 @@ class VIEW3D_PT_bounce_gi(Panel):
         layout.use_property_decorate = False
         settings = context.scene.bounce_gi
 
-        layout.prop(settings, "method")
+        layout.prop(settings, "use_time_budget")
+        if settings.use_time_budget:
+            layout.prop(settings, "time_budget_ms")
+        row = layout.row()
+        row.enabled = not settings.use_time_budget  # the budget picks the method
+        row.prop(settings, "method")
         layout.prop(settings, "resolution_percentage")
         layout.prop(settings, "output_path")
 
@@ -61,6 +66,8 @@ class VIEW3D_PT_bounce_gi_last_render(Panel):
         layout = self.layout
         last = preview.state.last
         layout.label(text=f"{last.method.upper()}  {last.width} x {last.height}", icon="IMAGE_DATA")
+        if last.quality:
+            layout.label(text=last.quality, icon="AUTO")
 
         col = layout.column(align=True)
         # Engine order is pipeline order; "total" goes last, then the wall time the user waited.

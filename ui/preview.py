@@ -34,6 +34,7 @@ class RenderReport:
     warnings: list
     wall_seconds: float  # submit to image written, as the user waited for it
     skipped: list = field(default_factory=list)  # passes reused from the engine's cache (time 0)
+    quality: str = ""  # what the time budget chose, and why ("" when the method was chosen by hand)
 
 
 @dataclass
@@ -64,6 +65,7 @@ class PendingRender:
     height: int
     scene_warnings: list = field(default_factory=list)
     started: float = field(default_factory=time.perf_counter)
+    quality: str = ""
 
     def elapsed(self) -> float:
         return time.perf_counter() - self.started
@@ -120,15 +122,31 @@ def start_render(scene, depsgraph) -> PendingRender:
         raise _unexpected(ex, "scene extraction") from None
     # Extraction owns the final size (it may clamp it); render exactly what it describes.
     width, height = (int(v) for v in scene_data.resolution)
+    render_settings, quality = RenderSettings(method=method, width=width, height=height), ""
+    if settings.use_time_budget:
+        render_settings, quality = budget_settings(settings.time_budget_ms, width, height)
+        method = render_settings.method
     try:
-        future = get_engine().submit_render(scene_data, RenderSettings(method=method, width=width, height=height))
+        future = get_engine().submit_render(scene_data, render_settings)
     except NotImplementedError as ex:
         raise _not_implemented(ex, method) from None
     except _user_facing_errors() as ex:
         raise PreviewError(one_line(ex)) from None
     except Exception as ex:
         raise _unexpected(ex, "render submission") from None
-    return PendingRender(future, method, width, height, list(scene_data.warnings))
+    return PendingRender(future, method, width, height, list(scene_data.warnings), quality=quality)
+
+
+def budget_settings(budget_ms: float, width: int, height: int):
+    """RenderSettings for a time budget from the measured quality table; (settings, one-line explanation)."""
+    from ..addon.quality import QualityError, choose, load_table, render_settings_for
+
+    try:
+        table = load_table()
+        choice = choose(table, budget_ms=budget_ms)
+    except QualityError as ex:
+        raise PreviewError(one_line(ex)) from None
+    return render_settings_for(choice, width, height), choice.describe(table)
 
 
 def finish_render(pending: PendingRender, timeout: float | None = None) -> RenderReport:
@@ -154,7 +172,7 @@ def finish_render(pending: PendingRender, timeout: float | None = None) -> Rende
     # Scene warnings first (they explain the render), then the engine's; drop repeats, keep order.
     warnings = list(dict.fromkeys([*pending.scene_warnings, *result.warnings]))
     report = RenderReport(pending.method, pending.width, pending.height, dict(result.timings), warnings,
-                          pending.elapsed(), list(getattr(result, "skipped", [])))
+                          pending.elapsed(), list(getattr(result, "skipped", [])), pending.quality)
     state.last, state.last_error = report, None
     return report
 

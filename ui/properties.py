@@ -4,7 +4,7 @@ Only user choices live here. Results of the last render are runtime state (see o
 so that a preview never dirties or bloats the file.
 """
 import bpy
-from bpy.props import EnumProperty, IntProperty, StringProperty
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty
 from bpy.types import PropertyGroup
 
 # Identifiers are upper case (Blender convention); the engine wants lower case (method_id()).
@@ -23,6 +23,20 @@ class BounceGISettings(PropertyGroup):
         description="How indirect (bounced) light is computed",
         items=METHOD_ITEMS,
         default="NONE",
+    )
+    use_time_budget: BoolProperty(
+        name="Time Budget",
+        description="Choose method and settings automatically: the most accurate measured (addon/quality_front.json, "
+                    "written by `bounce-gi bench`) that fits the frame time below",
+        default=False,
+    )
+    time_budget_ms: FloatProperty(
+        name="Budget (ms)",
+        description="Frame time the automatic choice may spend, in milliseconds (times measured on the machine "
+                    "named in the quality table)",
+        min=1.0,
+        soft_max=10000.0,
+        default=1000.0,
     )
     resolution_percentage: IntProperty(
         name="Resolution",
