@@ -131,7 +131,7 @@ def summary_markdown(report: dict) -> str:
 
 # ---- plot: numpy + OpenImageIO only (no matplotlib in the dependency list) ----
 
-PLOT_W, PLOT_H, MARGIN = 720, 520, (80, 30, 40, 60)  # left, right, top, bottom
+PLOT_W, PLOT_H, MARGIN = 860, 520, (80, 170, 40, 60)  # left, right (the legend), top, bottom
 COLOURS = {"none": (0.45, 0.45, 0.45), "lpv": (0.1, 0.45, 0.85), "vct": (0.55, 0.2, 0.75), "front": (0.0, 0.0, 0.0),
            "cycles": (0.85, 0.35, 0.1), "cycles_oidn": (0.1, 0.65, 0.3), "eevee": (0.85, 0.1, 0.45)}
 
@@ -222,5 +222,5 @@ def write_plot(path: str, entry: dict) -> None:
         legend = [("none", "none"), ("lpv", "lpv"), ("vct", "vct"), ("front", "our Pareto front"),
                   ("cycles", "Cycles"), ("cycles_oidn", "Cycles + OIDN"), ("eevee", "EEVEE")]
         for i, (key, name) in enumerate(legend):
-            text(PLOT_W - right - 120, top + 16 + 16 * i, "● " + name, COLOURS[key])
+            text(PLOT_W - right + 14, top + 16 + 16 * i, "● " + name, COLOURS[key])
     exr_io.write_png(path, (np.clip(buf.get_pixels(oiio.FLOAT), 0, 1) * 255 + 0.5).astype(np.uint8))

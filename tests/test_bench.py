@@ -110,7 +110,7 @@ def test_quick_files(quick):
     import OpenImageIO as oiio
 
     pixels = oiio.ImageBuf(plot).get_pixels(oiio.FLOAT)
-    assert pixels.shape[:2] == (520, 720) and pixels.std() > 0.01  # not a blank canvas
+    assert pixels.shape[:2] == (520, 860) and pixels.std() > 0.01  # not a blank canvas
     summary = open(report["summary"]).read()
     assert "| vct |" in summary and "| CYCLES | 16 spp + OIDN |" in summary and "Speed-up" in summary
     from bounce_gi.addon.quality import load_table
