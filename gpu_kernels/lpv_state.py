@@ -34,6 +34,11 @@ class LpvSettings:
     blend_cells: float = 2.0  # cascade border blend width (cells)
     bounces: int = 3  # indirect bounces (1 = light reflected once); bounces > 1 need occlusion
     lookup: str = "flux"  # "flux": absorbed face flux per area (conserves energy); "intensity": Kaplanyan's I/cell²
+    # Octree LPV (seed 002, lpv_octree.py): 0 = uniform grid; L ≥ 1 = full octree O_0..O_{L-1} (O_0 = this grid,
+    # O_i = n/2^i), index volume, per-level propagation, merge (L = 1: the octree path with one level, which equals
+    # the uniform grid with `octree_iterations` steps, one bounce, intensity lookup).
+    octree_levels: int = 0
+    octree_iterations: int = 4  # propagation steps on every octree level (seed 002 §4: k = 4)
 
     def __post_init__(self):
         if not 4 <= self.resolution <= 256:
@@ -46,6 +51,12 @@ class LpvSettings:
             raise ValueError(f"rsm_downsample must be 1, 2 or 4, not {self.rsm_downsample}")
         if self.bounces < 1 or self.max_iterations < 1 or self.rsm_resolution < 8:
             raise ValueError("bounces and max_iterations must be ≥ 1 and rsm_resolution ≥ 8")
+        if not 0 <= self.octree_levels <= 5 or self.octree_iterations < 1:
+            raise ValueError("octree_levels must be 0..5 and octree_iterations ≥ 1")
+        if self.octree_levels and (self.cascades != 1 or not self.occlusion
+                                   or 2 ** (self.octree_levels - 1) > self.resolution):
+            raise ValueError("the octree LPV needs cascades=1, occlusion (its index volume comes from the geometry "
+                             "volume) and 2^(octree_levels-1) ≤ resolution")
 
 
 def sh_basis(d) -> np.ndarray:
