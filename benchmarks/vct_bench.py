@@ -1,10 +1,12 @@
-"""VCT time per pass and error against Cycles for example scenes, over grid size and image size.
+"""VCT time per pass and error against Cycles for example scenes, over grid size, image size and indirect_scale.
 Prints a table (median of --repeats full re-renders after a warm-up render that compiles the shaders); asserts
 nothing. Errors are rel-L1 over pixels that hit geometry, against the mean of two Cycles seeds (64 spp, 8 bounces
-by default), with the reference's own noise floor (half the rel-L1 between its seeds) beside them.
+by default), with the reference's own noise floor (half the rel-L1 between its seeds) beside them. Glossy Indirect
+is compared over the pixels where both Cycles' and our Glossy Color are non-zero (a scene of Diffuse BSDFs gets no
+column; rough Principled surfaces above the cutoff count, with our 0); `glossy_cornell` is the Cornell box with a Principled floor of roughness 0.1.
 
-    .venv/bin/python benchmarks/vct_bench.py [--scenes cornell spot_room courtyard] [--grids 64 128]
-        [--res 320x240 640x480] [--bounces 1] [--samples 64] [--repeats 2]
+    .venv/bin/python benchmarks/vct_bench.py [--scenes cornell spot_room courtyard glossy_cornell]
+        [--grids 64 128] [--res 320x240 640x480] [--scales 1 2 4] [--bounces 1] [--samples 64] [--repeats 2]
 """
 import argparse
 import os
@@ -14,7 +16,24 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
-PASSES = ("vct_voxelize", "vct_inject", "vct_mipmap", "vct_bounce", "vct_trace")
+PASSES = ("vct_voxelize", "vct_inject", "vct_mipmap", "vct_bounce", "vct_specular", "vct_trace", "vct_upsample")
+EXTRA_SCENES = ("glossy_cornell",)
+
+
+def build_scene(name):
+    """An example scene (examples/scenes.py), or one of the benchmark's variants of them."""
+    import bpy
+
+    from examples import scenes
+
+    if name == "glossy_cornell":
+        scenes.build("cornell")
+        floor = bpy.data.objects["Floor"]
+        floor.data.materials.clear()
+        floor.data.materials.append(scenes.principled_material("GlossyFloor", scenes.CORNELL_WHITE, 0.1))
+        bpy.context.view_layer.update()
+    else:
+        scenes.build(name)
 
 
 def main():
@@ -22,6 +41,8 @@ def main():
     parser.add_argument("--scenes", nargs="+", default=["cornell", "spot_room", "courtyard"])
     parser.add_argument("--grids", nargs="+", type=int, default=[64, 128])
     parser.add_argument("--res", nargs="+", default=["320x240", "640x480"])
+    parser.add_argument("--scales", nargs="+", type=int, default=[1], help="VctSettings.indirect_scale values")
+    parser.add_argument("--specular", type=int, default=1, help="VctSettings.specular_cone (1 on, 0 off)")
     parser.add_argument("--bounces", type=int, default=1, help="VCT bounces (VctSettings.bounces)")
     parser.add_argument("--anisotropic", type=int, default=1, help="1: anisotropic volumes (default), 0: isotropic")
     parser.add_argument("--samples", type=int, default=64, help="Cycles samples per seed (0: skip the errors)")
@@ -30,6 +51,7 @@ def main():
     args = parser.parse_args()
 
     import bpy
+    import numpy as np
 
     from bounce_gi.addon.cycles_reference import ReferenceSettings, render_reference
     from bounce_gi.addon.extract import extract_scene
@@ -37,44 +59,53 @@ def main():
     from bounce_gi.gpu_kernels.engine import Engine
     from bounce_gi.gpu_kernels.pipeline import RenderSettings
     from bounce_gi.gpu_kernels.vct import VctSettings
-    from examples import scenes
 
     engine = Engine()
     print(f"GL: {engine.gl_info()['renderer']}; VCT bounces {args.bounces}, "
-          f"{'anisotropic' if args.anisotropic else 'isotropic'}; Cycles {args.samples} spp x 2 seeds, "
-          f"{args.ref_bounces} bounces; times: median of {args.repeats} after a warm-up (ms)")
-    header = (f"{'scene':<11}{'grid':>6}{'image':>9}" + "".join(f"{p[4:]:>10}" for p in PASSES) +
-              f"{'total':>9}{'DI relL1':>10}{'(floor)':>8}{'Comb relL1':>11}{'(floor)':>8}")
+          f"{'anisotropic' if args.anisotropic else 'isotropic'}, specular cone {'on' if args.specular else 'off'}; "
+          f"Cycles {args.samples} spp x 2 seeds, {args.ref_bounces} bounces; times: median of {args.repeats} after "
+          f"a warm-up (ms); fix = pixels traced again at full resolution by the upsampler")
+    header = (f"{'scene':<15}{'grid':>6}{'image':>9}{'s':>3}" + "".join(f"{p[4:]:>10}" for p in PASSES) +
+              f"{'total':>9}{'fix':>6}{'DI relL1':>10}{'(floor)':>8}{'Comb relL1':>11}{'(floor)':>8}"
+              f"{'GlI relL1':>10}{'(floor)':>8}")
     print(header)
     for name in args.scenes:
         for res in args.res:
             w, h = (int(v) for v in res.lower().split("x"))
-            scenes.build(name)
+            build_scene(name)
             scene = extract_scene(bpy.context.evaluated_depsgraph_get(), (w, h))
             ref = None
             if args.samples:
                 ref = render_reference(scene.content_hash(), ReferenceSettings(w, h, samples=args.samples,
                                                                                bounces=args.ref_bounces))
             for grid in args.grids:
-                vs = VctSettings(resolution=grid, bounces=args.bounces, anisotropic=bool(args.anisotropic))
-                settings = RenderSettings("vct", w, h, vct=vs)
-                engine.render(scene, settings)  # warm-up: compiles shaders
-                runs = []
-                for _ in range(args.repeats):
-                    engine.worker.call(lambda ctx: engine._pipeline.cache.clear())
-                    start = time.perf_counter()
-                    result = engine.render(scene, settings)
-                    runs.append((time.perf_counter() - start, result))
-                total = statistics.median(r[0] for r in runs)
-                result = runs[-1][1]
-                times = [statistics.median(r[1].timings.get(p, 0.0) for r in runs) * 1000 for p in PASSES]
-                errors = ""
-                if ref is not None:
-                    mask = (ref.passes["Depth"][..., 0] < 1e9) & (result.passes["Depth"][..., 0] < 1e9)
-                    errors = "".join(f"{metrics.rel_l1(result.passes[p], ref.passes[p], mask):>10.3f}"
-                                     f"{ref.noise_floor(p, mask):>8.3f} " for p in ("Diffuse Indirect", "Combined"))
-                print(f"{name:<11}{grid:>5}³{res:>9}" + "".join(f"{t:>10.0f}" for t in times) +
-                      f"{total * 1000:>9.0f}" + errors, flush=True)
+                for scale in args.scales:
+                    vs = VctSettings(resolution=grid, bounces=args.bounces, anisotropic=bool(args.anisotropic),
+                                     indirect_scale=scale, specular_cone=bool(args.specular))
+                    settings = RenderSettings("vct", w, h, vct=vs)
+                    engine.render(scene, settings)  # warm-up: compiles shaders
+                    runs = []
+                    for _ in range(args.repeats):
+                        engine.worker.call(lambda ctx: engine._pipeline.cache.clear())
+                        start = time.perf_counter()
+                        result = engine.render(scene, settings)
+                        runs.append((time.perf_counter() - start, result))
+                    total = statistics.median(r[0] for r in runs)
+                    result = runs[-1][1]
+                    times = [statistics.median(r[1].timings.get(p, 0.0) for r in runs) * 1000 for p in PASSES]
+                    errors = ""
+                    if ref is not None:
+                        mask = (ref.passes["Depth"][..., 0] < 1e9) & (result.passes["Depth"][..., 0] < 1e9)
+                        errors = "".join(f"{metrics.rel_l1(result.passes[p], ref.passes[p], mask):>10.3f}"
+                                         f"{ref.noise_floor(p, mask):>8.3f} " for p in ("Diffuse Indirect",
+                                                                                        "Combined"))
+                        glossy = mask & (ref.passes["Glossy Color"].max(axis=-1) > 0) & \
+                            (result.passes["Glossy Color"].max(axis=-1) > 0)
+                        if glossy.any() and "Glossy Indirect" in ref.passes:
+                            errors += (f"{metrics.rel_l1(result.passes['Glossy Indirect'], ref.passes['Glossy Indirect'], glossy):>9.3f}"
+                                       f"{ref.noise_floor('Glossy Indirect', glossy):>8.3f}")
+                    print(f"{name:<15}{grid:>5}³{res:>9}{scale:>3}" + "".join(f"{t:>10.0f}" for t in times) +
+                          f"{total * 1000:>9.0f}{result.info.get('fixup_pixels', 0):>6}" + errors, flush=True)
 
 
 if __name__ == "__main__":

@@ -13,7 +13,7 @@ from . import camera as cam
 from . import light_buffers as lb
 from .scene import Scene
 
-GBUFFER_TARGETS = ("position", "normal", "albedo", "emission", "geo_normal")
+GBUFFER_TARGETS = ("position", "normal", "albedo", "emission", "geo_normal", "glossy")
 
 
 @dataclass
@@ -130,6 +130,11 @@ class GBuffer:
     depth: object
     fbo: object
     size: tuple
+    # The camera the G-buffer was rendered from (view directions for the VCT specular cone): world position, unit
+    # view axis, orthographic flag.
+    eye: tuple = (0.0, 0.0, 0.0)
+    forward: tuple = (0.0, 0.0, -1.0)
+    ortho: bool = False
 
     def release(self):
         self.fbo.release()
@@ -165,7 +170,8 @@ def render_gbuffer(ctx, programs, scene: Scene, geometry: GeometryBuffers, textu
     set_uniform(prog, "u_camera_forward", tuple(forward))
     set_uniform(prog, "u_camera_ortho", camera.type == "ORTHO")
     draw_by_material(prog, scene, geometry, textures)
-    return GBuffer(targets, depth, fbo, (width, height))
+    return GBuffer(targets, depth, fbo, (width, height), tuple(float(c) for c in cam_world[:3, 3]),
+                   tuple(float(c) for c in forward), camera.type == "ORTHO")
 
 
 def bind_material(prog, scene: Scene, mat_index: int, textures: list) -> None:

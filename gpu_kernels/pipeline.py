@@ -15,7 +15,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from . import direct, lpv, vct
+from . import direct, lpv, vct, vct_specular, vct_temporal, vct_upsample
 from .light_buffers import ShadowSettings
 from .lpv import LpvSettings
 from .pass_cache import PassCache
@@ -24,8 +24,8 @@ from .scene import Scene, _hash_into
 from .vct import VctSettings
 
 METHODS = ("none", "lpv", "vct")
-PASS_NAMES = ("Combined", "Diffuse Direct", "Diffuse Indirect", "Diffuse Color", "Emission", "Normal", "Position",
-              "Depth")
+PASS_NAMES = ("Combined", "Diffuse Direct", "Diffuse Indirect", "Diffuse Color", "Glossy Indirect", "Glossy Color",
+              "Emission", "AO", "Normal", "Position", "Depth")
 BACKGROUND_DEPTH = 1e10  # Cycles writes 1e10 to the Depth pass where no geometry was hit
 
 
@@ -106,16 +106,22 @@ class Pipeline:
         k_direct = (k_gbuffer, k_shadow)
         direct_tex = cache.run("direct_light", k_direct,
                                lambda: direct.render_direct_light(ctx, programs, gbuffer, shadows))
-        indirect_tex, k_indirect, info = None, None, {}
+        indirect_tex, glossy_tex, k_indirect, info = None, None, None, {}
         if settings.method == "lpv":
             indirect_tex, k_indirect, info = self._lpv(scene, settings, geometry, textures, shadows, gbuffer,
                                                        k_geometry, k_materials, k_shadow, k_gbuffer)
         elif settings.method == "vct":
-            indirect_tex, k_indirect, info = self._vct(scene, settings, geometry, textures, shadows, gbuffer,
-                                                       k_geometry, k_materials, k_shadow, k_gbuffer)
-        passes = cache.run("compose", (k_direct, k_indirect, k_world), lambda: compose_passes(
-            gbuffer, direct_tex, scene.world.color,
-            None if indirect_tex is None else direct.read_texture(indirect_tex, 3)))
+            indirect_tex, glossy_tex, k_indirect, info = self._vct(scene, settings, geometry, textures, shadows,
+                                                                   gbuffer, k_geometry, k_materials, k_shadow,
+                                                                   k_gbuffer)
+
+        def compose():
+            indirect = None if indirect_tex is None else direct.read_texture(indirect_tex, 4)
+            return compose_passes(gbuffer, direct_tex, scene.world.color,
+                                  None if indirect is None else indirect[..., :3],
+                                  None if glossy_tex is None else direct.read_texture(glossy_tex, 3),
+                                  None if indirect is None or settings.method != "vct" else indirect[..., 3])
+        passes = cache.run("compose", (k_direct, k_indirect, k_world), compose)
         timings = dict(cache.timings)
         timings["total"] = time.perf_counter() - start
         return RenderResult(passes=passes, timings=timings, skipped=list(cache.skipped),
@@ -140,7 +146,17 @@ class Pipeline:
         states = cache.run("lpv_inject", k_inject, lambda: lpv.inject_all(ctx, programs, rsm, shadows, grids,
                                                                           scene.world.color, gvs, s.rsm_downsample))
         k_prop = (k_inject, k_gv, repr(s))
-        stats = cache.run("lpv_propagate", k_prop, lambda: lpv.propagate_all(ctx, programs, states, gvs, s))
+        if s.octree_levels:  # seed 002 (lpv_octree.py): index volume, downsample, per-level propagation, merge
+            from . import lpv_octree as lo
+            geo = cache.run("lpv_octree_geometry", (k_gv, s.octree_levels),
+                            lambda: lo.build_geometry(ctx, gvs[0], grids[0], s.octree_levels))
+            tree = cache.run("lpv_downsample", (k_inject, s.octree_levels),
+                             lambda: lo.downsample(ctx, programs, states[0], geo))
+            stats = cache.run("lpv_propagate", k_prop, lambda: lo.propagate_levels(ctx, programs, tree, geo, s))
+            merged = cache.run("lpv_merge", k_prop, lambda: lo.merge(ctx, programs, tree, geo))
+            states, gvs, s = [merged], [None], lo.lookup_settings(s)
+        else:
+            stats = cache.run("lpv_propagate", k_prop, lambda: lpv.propagate_all(ctx, programs, states, gvs, s))
         k_light = (k_gbuffer, k_prop)
         indirect = cache.run("lpv_lighting", k_light, lambda: lpv.lighting(ctx, programs, gbuffer, states, gvs, s))
         return indirect, k_light, stats
@@ -149,7 +165,9 @@ class Pipeline:
              k_gbuffer):
         """VCT passes (seed 004): vct_voxelize ← geometry, materials, grid; vct_inject ← voxels, shadow maps (lights);
         vct_mipmap ← injection, anisotropy; vct_bounce ← mipmaps, world, cone settings, bounces;
-        vct_trace ← gbuffer, bounced volumes, cone settings."""
+        vct_specular ← gbuffer, bounced volumes, specular settings; vct_trace ← gbuffer, bounced volumes, trace
+        settings, accumulation frame; vct_upsample ← vct_trace (indirect_scale > 1); vct_accumulate ← the upsampled
+        trace (temporal_frames > 1). Returns (Diffuse Indirect + AO texture, Glossy Indirect texture, key, info)."""
         ctx, programs, cache, s = self.ctx, self.programs, self.cache, settings.vct
         grid = vct.vct_grid(scene, s)
         levels = vct.mip_levels(s.resolution)
@@ -165,31 +183,60 @@ class Pipeline:
         k_bounce = (k_mip, world, s.key("bounce"))
         bounced = cache.run("vct_bounce", k_bounce,
                             lambda: vct.bounce(ctx, programs, vox, faces, volumes, s, world))
-        k_trace = (k_gbuffer, k_bounce, s.key("trace"))
-        traced = cache.run("vct_trace", k_trace, lambda: vct.trace(ctx, programs, gbuffer, faces, bounced, s,
-                                                                          world))
-        return traced["indirect"], k_trace, vct.render_info(faces, bounced, s)
+        k_spec = (k_gbuffer, k_bounce, s.key("specular"))
+        glossy = cache.run("vct_specular", k_spec, lambda: vct_specular.specular(ctx, programs, gbuffer, faces,
+                                                                                  bounced, s, world))
+        # Temporal accumulation: the trace's inputs key the history; while it holds fewer than temporal_frames
+        # frames, the frame index makes the keys new, so trace (and upsample) run again with the next jitter.
+        base = (k_gbuffer, k_bounce, s.key("trace"))
+        accumulating = s.temporal_frames > 1
+        prior = cache.entries.get("vct_accumulate")
+        frame = vct_temporal.frame_index(prior.value if prior and accumulating else None, base, s.temporal_frames)
+        rotation = vct_temporal.jitter_deg(s, frame) if accumulating else s.cone_rotation
+        k_trace = (base, frame)
+        traced = cache.run("vct_trace", k_trace, lambda: vct.trace(ctx, programs, gbuffer, faces, bounced, s, world,
+                                                                   rotation))
+        info = vct.render_info(faces, bounced, s)
+        info["specular_pixels"] = glossy["traced"]
+        indirect = traced["indirect"]
+        if s.indirect_scale > 1:
+            up = cache.run("vct_upsample", k_trace, lambda: vct_upsample.upsample(
+                ctx, programs, gbuffer, traced, faces, bounced, s, world, rotation))
+            indirect, info["fixup_pixels"] = up["indirect"], up["fixup"]
+        if accumulating:
+            history = cache.run("vct_accumulate", k_trace, lambda: vct_temporal.accumulate(
+                ctx, programs, prior.value if prior else None, indirect, base, frame))
+            indirect = history.texture
+            info["temporal"] = {"frames": history.frames, "of": s.temporal_frames,
+                                "done": history.frames >= s.temporal_frames}
+        return indirect, glossy["glossy"], (k_trace, k_spec), info
 
     def release(self) -> None:
         self.cache.clear()
         self.programs.release()
 
 
-def compose_passes(gbuffer, direct_tex, world_color, indirect: np.ndarray | None = None) -> dict:
-    """Read the GPU results back and build the Cycles-named passes; Combined = (direct+indirect)·colour + emission."""
+def compose_passes(gbuffer, direct_tex, world_color, indirect: np.ndarray | None = None,
+                   glossy: np.ndarray | None = None, ao: np.ndarray | None = None) -> dict:
+    """Read the GPU results back and build the Cycles-named passes; Combined = (direct+indirect)·colour +
+    Glossy Indirect·Glossy Color + emission. `indirect`, `glossy`: (H, W, 3) Diffuse / Glossy Indirect; `ao`: (H, W)
+    voxel AO. Methods without them get zeros (AO: 1 on geometry), so every method writes the same passes."""
     position = direct.read_texture(gbuffer.textures["position"])
     hit = position[..., 3:4] > 0.5
     normal = direct.read_texture(gbuffer.textures["normal"])
     albedo = direct.read_texture(gbuffer.textures["albedo"], 3) * hit
+    glossy_color = direct.read_texture(gbuffer.textures["glossy"], 3) * hit
     emission = direct.read_texture(gbuffer.textures["emission"], 3) * hit
     # Cycles divides its light passes by Diffuse Color per channel and writes 0 where that colour is 0
-    # (safe_divide_even_color), so a surface with no diffuse part shows no diffuse light.
+    # (safe_divide_even_color), so a surface with no diffuse part shows no diffuse light; glossy likewise.
     has_diffuse = albedo > 0
     diffuse_direct = direct.read_texture(direct_tex, 3) * has_diffuse
     diffuse_indirect = np.zeros_like(diffuse_direct) if indirect is None else indirect * has_diffuse
+    glossy_indirect = np.zeros_like(diffuse_direct) if glossy is None else glossy * (glossy_color > 0)
+    ao_pass = np.repeat((hit[..., 0] if ao is None else ao * hit[..., 0])[..., None], 3, axis=2)
     combined = np.empty(albedo.shape[:2] + (4,), np.float32)
-    combined[..., :3] = np.where(hit, (diffuse_direct + diffuse_indirect) * albedo + emission,
-                                 np.asarray(world_color, np.float32)[:3])
+    combined[..., :3] = np.where(hit, (diffuse_direct + diffuse_indirect) * albedo + glossy_indirect * glossy_color
+                                 + emission, np.asarray(world_color, np.float32)[:3])
     combined[..., 3] = 1.0  # the world is visible to the camera (film not transparent), as in Cycles' default
     depth = np.where(hit, normal[..., 3:4], BACKGROUND_DEPTH).astype(np.float32)
     return {
@@ -197,7 +244,10 @@ def compose_passes(gbuffer, direct_tex, world_color, indirect: np.ndarray | None
         "Diffuse Direct": diffuse_direct.astype(np.float32),
         "Diffuse Indirect": diffuse_indirect.astype(np.float32),
         "Diffuse Color": albedo.astype(np.float32),
+        "Glossy Indirect": glossy_indirect.astype(np.float32),
+        "Glossy Color": glossy_color.astype(np.float32),
         "Emission": emission.astype(np.float32),
+        "AO": ao_pass.astype(np.float32),
         "Normal": (normal[..., :3] * hit).astype(np.float32),
         "Position": (position[..., :3] * hit).astype(np.float32),
         "Depth": depth,

@@ -8,7 +8,11 @@ Passes (pipeline.py wires them into the pass cache):
   vct_mipmap    the filtered radiance volumes: isotropic (mean of children) or anisotropic (six directions,
                 composited front to back) (vct_mipmap.glsl, seed 004 §4.4);
   vct_bounce    bounces − 1 gathers at the voxel faces, each followed by a re-mip (vct_bounce.glsl);
-  vct_trace     diffuse cones per G-buffer pixel → Diffuse Indirect and voxel AO (vct_trace.glsl, seed 004 §4.5.2).
+  vct_trace     diffuse cones per G-buffer pixel (or per s × s block, indirect_scale) → Diffuse Indirect and voxel
+                AO (vct_trace.glsl, seed 004 §4.5.2);
+  vct_upsample  reduced-resolution results back to every pixel, depth- and normal-aware (vct_upsample.py, seed 003);
+  vct_accumulate  temporal average of jittered cone sets (vct_temporal.py);
+  vct_specular  one glossy cone per pixel → Glossy Indirect (vct_specular.py).
 
 Every scale is derived; the shaders' comments give the derivations (self-occlusion bound, step opacity, anisotropic
 optical depth), `cone_table` gives the cones'. Sky light: the world colour fills what is left of every cone that
@@ -38,8 +42,19 @@ class VctSettings:
     bounces: int = 1  # indirect bounces in Diffuse Indirect (1 = light reflected once; Cycles' "1 bounce")
     step_multiplier: float = 0.5  # step / sampled voxel size (seed 004 listing 4.1 steps by the cone radius)
     start_offset: float = 1.5  # voxels along the normal (× ‖n‖₁): the trilinear support of the own texel
-    specular_cone: bool = False  # not implemented yet (the G-buffer carries no roughness); must stay False
-    roughness_cutoff: float = 0.5  # specular cone skipped above this roughness (when implemented)
+    # One glossy cone per pixel along the reflected view direction → Glossy Indirect (vct_specular.py); pixels
+    # with no glossy closure or rougher than roughness_cutoff run no cone, so scenes without glossy materials pay
+    # one texture fetch per pixel.
+    specular_cone: bool = True
+    roughness_cutoff: float = 0.5  # specular cone skipped above this Principled roughness (Glossy Indirect = 0)
+    # Diffuse cones traced at (width/s) × (height/s) and brought back to full resolution by a depth- and
+    # normal-aware upsampling (seed 003, inferred lighting; vct_upsample.py). 1 = every pixel.
+    indirect_scale: int = 1
+    # Temporal accumulation (vct_temporal.py): each render turns the diffuse cone set about the normal by another
+    # angle and averages into a history, until this many frames are in; any change to the trace's inputs restarts
+    # it. 0 or 1 = off.
+    temporal_frames: int = 0
+    cone_rotation: float = 0.0  # degrees the diffuse cone set is turned about the normal (the jitter adds to it)
     # Six directional volumes (Crassin) rather than one isotropic volume. Default on, measured: isotropic voxels
     # show a wall's lit side from both sides, and with 4 bounces Cornell / courtyard Diffuse Indirect came out
     # 1.8× / 5.1× as bright as 8-bounce Cycles (anisotropic: 0.96× / 0.98×).
@@ -58,17 +73,23 @@ class VctSettings:
             (0.0 <= self.start_offset <= 8.0, f"start_offset {self.start_offset} out of range 0..8 voxels"),
             (0.0 <= self.roughness_cutoff <= 1.0, f"roughness_cutoff {self.roughness_cutoff} out of range 0..1"),
             (self.ao_distance >= 0 and math.isfinite(self.ao_distance), "ao_distance must be ≥ 0"),
-            (not self.specular_cone, "specular_cone is not implemented yet"),
+            (self.indirect_scale in (1, 2, 4), f"indirect_scale {self.indirect_scale} must be 1, 2 or 4"),
+            (0 <= self.temporal_frames <= 256, f"temporal_frames {self.temporal_frames} out of range 0..256"),
+            (math.isfinite(self.cone_rotation), "cone_rotation must be finite"),
         ]
         for ok, message in checks:
             if not ok:
                 raise ValueError(message)
 
     def key(self, kind: str) -> tuple:
-        """The settings a pass reads: 'bounce' or 'trace' (resolution and anisotropy key the earlier passes)."""
-        extra = ("bounces",) if kind == "bounce" else ("ao_distance", "specular_cone", "roughness_cutoff")
+        """The settings a pass reads: 'bounce', 'trace' (diffuse cones per pixel, upsampling, accumulation) or
+        'specular' (resolution and anisotropy key the earlier passes)."""
+        extra = {"bounce": CONE_FIELDS + ("bounces",),
+                 "trace": CONE_FIELDS + ("ao_distance", "indirect_scale", "cone_rotation", "temporal_frames"),
+                 "specular": ("max_distance", "step_multiplier", "start_offset", "specular_cone",
+                              "roughness_cutoff")}[kind]
         d = asdict(self)
-        return tuple((name, d[name]) for name in CONE_FIELDS + extra)
+        return tuple((name, d[name]) for name in extra)
 
 
 def cone_table(count: int, aperture_deg: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

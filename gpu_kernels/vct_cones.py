@@ -2,6 +2,8 @@
 plus readbacks for tests and statistics. Data types, settings and the injection / mipmap passes are in vct.py."""
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from . import direct
@@ -57,21 +59,50 @@ def bounce(ctx, programs, vox, direct_faces: Faces, volumes: ConeVolumes, s: Vct
     return own
 
 
-def trace(ctx, programs, gbuffer, faces: Faces, volumes: ConeVolumes, s: VctSettings, world) -> dict:
-    """Diffuse cones per G-buffer pixel (vct_trace.glsl): {'indirect': RGBA32F texture, rgb = Diffuse Indirect
-    (irradiance/π), a = voxel AO}."""
-    w, h = gbuffer.size
+def trace(ctx, programs, gbuffer, faces: Faces, volumes: ConeVolumes, s: VctSettings, world,
+          rotation_deg: float | None = None) -> dict:
+    """Diffuse cones per G-buffer pixel, or per indirect_scale² block (vct_trace.glsl): {'indirect': RGBA32F
+    texture of ceil(W/s) × ceil(H/s), rgb = Diffuse Indirect (irradiance/π), a = voxel AO; 'scale': s}. The cone
+    set is turned by `rotation_deg` about the normal (default s.cone_rotation)."""
+    scale = int(s.indirect_scale)
+    fw, fh = gbuffer.size
+    w, h = -(-fw // scale), -(-fh // scale)
     out = ctx.texture((w, h), 4, dtype="f4")
-    prog = programs.compute("vct_trace.glsl", {"MODE_ANISO": None} if volumes.anisotropic else None)
+    prog = _trace_program(programs, gbuffer, faces, volumes, s, world, rotation_deg, fixup=False)
+    direct._set(prog, "u_image_size", (w, h))
+    direct._set(prog, "u_scale", scale)
+    out.bind_to_image(0, read=False, write=True)
+    prog.run((w + 7) // 8, (h + 7) // 8, 1)
+    ctx.memory_barrier()
+    return {"indirect": out, "scale": scale}
+
+
+def fixup(ctx, programs, gbuffer, faces: Faces, volumes: ConeVolumes, s: VctSettings, world, texture,
+          rotation_deg: float | None = None) -> None:
+    """Trace, in place and at full resolution, the pixels of `texture` that vct_upsample.glsl marked (a < 0)."""
+    w, h = gbuffer.size
+    prog = _trace_program(programs, gbuffer, faces, volumes, s, world, rotation_deg, fixup=True)
+    direct._set(prog, "u_image_size", (w, h))
+    direct._set(prog, "u_scale", 1)
+    texture.bind_to_image(0, read=True, write=True)
+    prog.run((w + 7) // 8, (h + 7) // 8, 1)
+    ctx.memory_barrier()
+
+
+def _trace_program(programs, gbuffer, faces, volumes, s, world, rotation_deg, fixup: bool):
+    defines = {"MODE_ANISO": None} if volumes.anisotropic else {}
+    if fixup:
+        defines["MODE_FIXUP"] = None
+    prog = programs.compute("vct_trace.glsl", defines or None)
     unit = _units(prog, "u_volume", volumes.textures, 0)
     unit = _units(prog, "u_centroid", faces.centroids, unit)
     for name in ("position", "normal", "geo_normal"):
         unit = _units(prog, f"u_{name}", [gbuffer.textures[name]], unit)
     _cone_uniforms(prog, volumes.grid, volumes.levels, s, world)
-    direct._set(prog, "u_image_size", (w, h))
-    out.bind_to_image(0, read=False, write=True)
-    prog.run((w + 7) // 8, (h + 7) // 8, 1)
-    return {"indirect": out}
+    phi = math.radians(s.cone_rotation if rotation_deg is None else rotation_deg)
+    direct._set(prog, "u_rotation", (math.cos(phi), math.sin(phi)))
+    direct._set(prog, "u_full_size", tuple(int(n) for n in gbuffer.size))
+    return prog
 
 
 def read_ao(texture) -> np.ndarray:

@@ -269,7 +269,9 @@ def test_passes_rerun_only_downstream_and_ao_is_sky_visibility(engine, furnace):
                                  dict(diffuse_cones=10), dict(diffuse_aperture=-1.0), dict(diffuse_aperture=90.0),
                                  dict(max_distance=-1.0), dict(bounces=0), dict(bounces=17),
                                  dict(step_multiplier=0.0), dict(step_multiplier=3.0), dict(start_offset=-0.1),
-                                 dict(roughness_cutoff=1.5), dict(ao_distance=-1.0), dict(specular_cone=True)])
+                                 dict(roughness_cutoff=1.5), dict(ao_distance=-1.0), dict(indirect_scale=3),
+                                 dict(indirect_scale=0), dict(temporal_frames=-1),
+                                 dict(temporal_frames=1000), dict(cone_rotation=math.inf)])
 def test_settings_are_validated(bad):
     with pytest.raises(ValueError):
         VctSettings(**bad)
@@ -281,6 +283,12 @@ def test_defaults_are_valid_and_keys_separate_passes():
     assert VctSettings(bounces=3).key("trace") == s.key("trace")  # bounces re-run vct_bounce, not more
     assert VctSettings(bounces=3).key("bounce") != s.key("bounce")
     assert VctSettings(ao_distance=1.0).key("bounce") == s.key("bounce")
+    assert s.specular_cone  # on by default: pixels with no glossy closure skip it (vct_specular.py)
+    for change in (dict(indirect_scale=2), dict(temporal_frames=4), dict(cone_rotation=10.0)):
+        assert VctSettings(**change).key("trace") != s.key("trace") and VctSettings(**change).key("specular") == \
+            s.key("specular") and VctSettings(**change).key("bounce") == s.key("bounce")
+    assert VctSettings(roughness_cutoff=0.2).key("specular") != s.key("specular")
+    assert VctSettings(roughness_cutoff=0.2).key("trace") == s.key("trace")
 
 
 @pytest.mark.parametrize("count", range(5, 10))

@@ -1,4 +1,5 @@
-// G-buffer from the scene camera: world position, shading normal, diffuse colour, emission, geometric normal.
+// G-buffer from the scene camera: world position, shading normal, diffuse colour, emission, geometric normal, glossy
+// colour and roughness (the VCT specular cone, vct_specular.glsl).
 // Sampled at pixel centres with no MSAA, like Cycles with a ~0.01 px pixel filter (design.md §3).
 #if defined(VERTEX_SHADER)
 #include "surface_vertex.glsl"
@@ -19,6 +20,7 @@ layout(location = 1) out vec4 out_normal;        // xyz shading normal facing th
 layout(location = 2) out vec4 out_albedo;        // rgb Diffuse Color, w = 1
 layout(location = 3) out vec4 out_emission;      // rgb emitted radiance (emission colour × strength)
 layout(location = 4) out vec4 out_geo_normal;    // xyz geometric normal facing the viewer
+layout(location = 5) out vec4 out_glossy;        // rgb Glossy Color, w = Principled roughness
 
 void main() {
     vec3 view_dir = u_camera_ortho ? -u_camera_forward : normalize(u_camera_position - v_position);
@@ -34,5 +36,6 @@ void main() {
     out_albedo = vec4(diffuse_albedo(v_uv, dot(n, view_dir)), 1.0);
     out_emission = vec4(u_emission, 1.0);
     out_geo_normal = vec4(geo_n, 0.0);
+    out_glossy = vec4(glossy_albedo(v_uv, dot(n, view_dir)), u_roughness);
 }
 #endif

@@ -34,7 +34,7 @@ void main() {
         if (direct[g].a > 0.0 && reflects) {
             vec3 n = vec3(0.0);
             n[g >> 1] = (g & 1) == 0 ? 1.0 : -1.0;
-            vec4 e = gather_irradiance(centroid_face(g, v, 0).xyz, n, n);
+            vec4 e = gather_irradiance(centroid_face(g, v, 0).xyz, n, n, vec2(1.0, 0.0));
             radiance += albedo * e.rgb / VCT_PI;
         }
         store_face(g, v, vec4(radiance, direct[g].a));

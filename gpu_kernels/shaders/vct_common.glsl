@@ -155,7 +155,9 @@ vec3 cone_origin(vec3 p, vec3 n_geo) {
 
 // Irradiance E at p over the hemisphere of n (rgb), and the cosine-weighted AO / sky visibility (a, in [0, 1]):
 // E = Σ_k w_k·(L_k + T_k·L_world if cone k left the grid), with Σ_k w_k = π (vct.cone_table).
-vec4 gather_irradiance(vec3 p, vec3 n, vec3 n_geo) {
+// rot = (cos φ, sin φ): the cone set turned by φ around the normal (vct_temporal.py jitters φ from frame to frame;
+// the weights are unchanged, since rotating the regions about the normal keeps their cosine integrals).
+vec4 gather_irradiance(vec3 p, vec3 n, vec3 n_geo, vec2 rot) {
     vec3 o = cone_origin(p, n_geo);
     vec3 t1, t2;
     onb(n, t1, t2);
@@ -163,7 +165,8 @@ vec4 gather_irradiance(vec3 p, vec3 n, vec3 n_geo) {
     float ao = 0.0;
     for (int k = 0; k < u_cone_count; ++k) {
         vec4 c = u_cones[k];
-        vec3 d = normalize(t1 * c.x + t2 * c.y + n * c.z);
+        vec2 xy = vec2(rot.x * c.x - rot.y * c.y, rot.y * c.x + rot.x * c.y);
+        vec3 d = normalize(t1 * xy.x + t2 * xy.y + n * c.z);
         ConeResult r = trace_cone(p, o, n_geo, d, u_cone_tan[k]);
         e += c.w * (r.radiance + (r.exited ? r.transmittance * u_world : vec3(0.0)));
         ao += c.w * r.ao;
