@@ -1,0 +1,37 @@
+"""Shared fixtures: one Cycles reference cache per test session, and the example-scene comparison runner."""
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(scope="session")
+def reference_cache(tmp_path_factory):
+    """Where Cycles references go: $BOUNCE_GI_TEST_CACHE to reuse them across runs, else fresh per session."""
+    return os.environ.get("BOUNCE_GI_TEST_CACHE") or str(tmp_path_factory.mktemp("refcache"))
+
+
+@pytest.fixture(scope="session")
+def compare_examples(reference_cache, tmp_path_factory):
+    """run(samples, names, *args) → {name: compare report}: tests/support/compare_examples.py in a subprocess
+    (bpy's global state stays out of pytest), sharing the session's reference cache."""
+    user = str(tmp_path_factory.mktemp("blender_user"))
+
+    def run(samples, names, *args, timeout=900):
+        env = dict(os.environ, BOUNCE_GI_CACHE=reference_cache, BLENDER_USER_RESOURCES=user)
+        proc = subprocess.run([sys.executable, str(ROOT / "tests/support/compare_examples.py"), str(samples),
+                               *names, *map(str, args)], capture_output=True, text=True, env=env, timeout=timeout)
+        line = next((l for l in proc.stdout.splitlines() if l.startswith("RESULT ")), None)
+        assert proc.returncode == 0 and line, f"comparison run failed:\n{proc.stdout[-3000:]}\n{proc.stderr[-3000:]}"
+        data = json.loads(line[len("RESULT "):])
+        for name, r in data.items():
+            print(name, *args, "rel-L1", {k: round(v, 3) for k, v in r["rel_l1"].items()}, "noise floor",
+                  {k: round(v, 3) for k, v in r["noise_floor"].items()})
+        return data
+
+    return run

@@ -1,0 +1,55 @@
+"""VCT against full-bounce Cycles on the typical interiors (issue: Voxel Cone Tracing) — regression bounds.
+
+160×120, default VctSettings (64³, 9 cones, 8 bounces of which 4 gathered) and a single bounce, against Cycles
+128 spp × 2 seeds with 8 bounces. Bounds = today's measured error × 1.05 + 0.05: the references are seeded (the
+same Cycles build renders the same noise), so the margin is for a different Cycles build or GL driver moving the
+noise (Diffuse Indirect noise floor ~0.07–0.12 here; half of it can move our rel-L1 either way). The issue's
+targets are Diffuse Indirect ≤ 20%, Combined ≤ 8%: by default the spot room meets both (0.159 / 0.058), Cornell
+meets Diffuse Indirect only (0.187 / 0.093), the courtyard neither (0.261 / 0.181). A change that makes VCT worse
+fails here; one that makes it better should lower these bounds.
+"""
+import pytest
+
+# measured, rel-L1 Diffuse Indirect / Combined, defaults: cornell 0.187 / 0.093, spot_room 0.159 / 0.058,
+# courtyard 0.261 / 0.181
+DEFAULT = {"cornell": {"diffuse_indirect": 0.25, "combined": 0.15},
+           "spot_room": {"diffuse_indirect": 0.22, "combined": 0.11},
+           "courtyard": {"diffuse_indirect": 0.33, "combined": 0.24}}
+# measured, 1 bounce: cornell 0.432 / 0.201, spot_room 0.708 / 0.264, courtyard 0.655 / 0.445
+ONE = {"cornell": {"diffuse_indirect": 0.51, "combined": 0.26},
+       "spot_room": {"diffuse_indirect": 0.80, "combined": 0.33},
+       "courtyard": {"diffuse_indirect": 0.74, "combined": 0.52}}
+
+
+@pytest.fixture(scope="module")
+def default(compare_examples):
+    return compare_examples(128, list(DEFAULT), "--method", "vct")
+
+
+@pytest.fixture(scope="module")
+def one(compare_examples):
+    return compare_examples(128, list(ONE), "--method", "vct", "--vct", "bounces=1")
+
+
+def _check(r, bounds):
+    for key, bound in bounds.items():
+        assert r["rel_l1"][key] <= bound, (key, r["rel_l1"], r["noise_floor"])
+    assert r["rel_l1"]["diffuse_direct"] <= 0.03  # the direct light is method 'none''s (test_direct_vs_cycles)
+
+
+@pytest.mark.parametrize("name", list(DEFAULT))
+def test_vct_default_error_does_not_regress(default, name):
+    _check(default[name], DEFAULT[name])
+
+
+@pytest.mark.parametrize("name", list(ONE))
+def test_vct_one_bounce_error_does_not_regress(one, name):
+    _check(one[name], ONE[name])
+
+
+def test_more_bounces_get_closer_to_full_bounce_cycles(default, one):
+    """Cycles has 8 bounces; ours with 8 (extrapolated past 4) must be nearer on Diffuse Indirect than with 1 in
+    every scene, by a wide margin (measured 0.43 → 0.19, 0.71 → 0.16, 0.66 → 0.26): if it were not, the bounces
+    and their tail would not be adding the light they carry."""
+    for name in DEFAULT:
+        assert default[name]["rel_l1"]["diffuse_indirect"] < 0.7 * one[name]["rel_l1"]["diffuse_indirect"], name
