@@ -27,7 +27,7 @@ QUICK_RES = (96, 72)
 QUALITY_FILE = "quality_front.json"  # what the bench writes for automatic quality (quality.py reads it)
 # The settings a sweep varies per method; the summary names rows by these.
 SWEPT_KEYS = {"lpv": ("resolution", "cascades", "max_iterations", "bounces"),
-              "vct": ("resolution", "diffuse_cones", "bounces", "indirect_scale")}
+              "vct": ("resolution", "diffuse_cones", "bounces", "gathered_bounces", "indirect_scale")}
 FLIP_CODE = ("import sys, flip_evaluator as f; "
              "print('FLIP', float(f.evaluate(sys.argv[1], sys.argv[2], 'LDR', applyMagma=False)[1]))")
 
@@ -55,10 +55,12 @@ def sweep(quick: bool, width: int, height: int) -> list:
     lpv = [dict(resolution=16, bounces=1), {}] if quick else [
         dict(resolution=16, bounces=1), dict(resolution=16), dict(resolution=32, bounces=1), {},
         dict(max_iterations=16), dict(cascades=3)]
-    vct_fields = {f for f in asdict(VctSettings())}
-    vct = [dict(resolution=32), {}] if quick else [
-        dict(resolution=32), {}, dict(diffuse_cones=9), dict(bounces=4), dict(resolution=128)] + \
-        ([dict(indirect_scale=2), dict(indirect_scale=4)] if "indirect_scale" in vct_fields else [])
+    # VCT: the cheap corner (32³, 6 cones, 1 bounce), a fast multi-bounce point, the single bounce at 64³, the
+    # default, every bounce gathered (what the extrapolated tail saves), 128³, and reduced-resolution tracing.
+    vct = [dict(resolution=32, diffuse_cones=6, bounces=1), {}] if quick else [
+        dict(resolution=32, diffuse_cones=6, bounces=1), dict(resolution=32, diffuse_cones=6, gathered_bounces=3),
+        dict(diffuse_cones=6, bounces=1), {}, dict(gathered_bounces=0), dict(resolution=128, bounces=1),
+        dict(indirect_scale=2), dict(indirect_scale=4)]
     for changes in lpv:
         s = replace(LpvSettings(), **changes)
         rows.append(("lpv", asdict(s), replace(base, method="lpv", lpv=s), s == LpvSettings()))
