@@ -1,4 +1,4 @@
-"""The peers `bounce-gi bench` measures on the same scene and resolution: Cycles at 1…64 samples without and with
+"""The peers `bounce-gi bench` measures on the same scene and resolution: Cycles at 1…256 samples (1…16 with --quick) without and with
 OpenImageDenoise, and EEVEE at its defaults (its first render compiles shaders, so the second is timed).
 
 Peer times are bpy.ops.render.render wall time: scene sync, render and writing the EXR, as a user would wait.
@@ -49,7 +49,7 @@ def render_peers(ref, mask, width, height, quick, progress, tmp, eevee=True) -> 
         except Exception as exc:  # noqa: BLE001 — a peer failing must not end the benchmark
             warnings.append(f"Cycles warm-up failed: {exc}")
         for denoise in (False, True):
-            for spp in ((1, 4, 16) if quick else (1, 4, 16, 64)):
+            for spp in ((1, 4, 16) if quick else (1, 4, 16, 64, 256)):
                 entry = {"engine": "CYCLES", "samples": spp, "denoise": denoise, "seconds": None,
                          "rel_l1": {"combined": None}}
                 progress(f"bench: Cycles {spp} spp" + (" + OIDN" if denoise else ""))

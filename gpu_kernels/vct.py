@@ -40,6 +40,11 @@ class VctSettings:
     # gathered, 160×120, against 8-bounce Cycles): Cornell Diffuse Indirect rel-L1 0.197 vs 0.239 with 6 — fewer, wider cones leave
     # lobe-shaped bright and dark patches on walls facing a lit surface.
     diffuse_cones: int = 9
+    # Cones per voxel face in the bounce gathers (vct_bounce); 0 = diffuse_cones. Bounced light is smooth, and
+    # these gathers are most of a multi-bounce frame's time. Default 6, measured against 9 (64³, defaults otherwise,
+    # Combined rel-L1 / bounce pass on llvmpipe): Cornell 0.092 vs 0.093 / 3.6 s vs 4.9 s, spot room 0.053 vs
+    # 0.058, courtyard 0.180 vs 0.181; 5 cones: 0.095 / 3.2 s, 0.058, 0.169.
+    bounce_cones: int = 6
     diffuse_aperture: float = 0.0  # cone half-angle (degrees); 0 = derived: a cone of the region's solid angle
     max_distance: float = 0.0  # metres a cone travels; 0 = until it leaves the grid (or is fully occluded)
     # Indirect bounces in Diffuse Indirect (1 = light reflected once; Cycles' "1 bounce"). Default 8 like Cycles'
@@ -49,7 +54,7 @@ class VctSettings:
     # Gather only this many bounces and extrapolate the rest up to `bounces` as a geometric series of the last
     # increment (vct_cones._extrapolate_tail); 0 = gather every bounce. Each gathered bounce is a full cone pass
     # over the voxels, the tail a few array operations. Default 4, measured against gathering all 8 (Combined
-    # rel-L1, 64³, 9 cones): Cornell 0.093 vs 0.092, spot room 0.058 vs 0.056, courtyard 0.181 vs 0.180 in half the
+    # rel-L1, 64³, 9 cones everywhere): Cornell 0.093 vs 0.092, spot room 0.058 vs 0.056, courtyard 0.181 vs 0.180 in half the
     # time (Cornell bounce pass 4.8 s vs 11.0 s on llvmpipe); gathering 3 was 0.098 / 0.057 / 0.198.
     gathered_bounces: int = 4
     step_multiplier: float = 0.5  # step / sampled voxel size (seed 004 listing 4.1 steps by the cone radius)
@@ -77,6 +82,8 @@ class VctSettings:
         checks = [
             (16 <= self.resolution <= 512, f"resolution {self.resolution} out of range 16..512"),
             (5 <= self.diffuse_cones <= MAX_CONES, f"diffuse_cones {self.diffuse_cones} out of range 5..{MAX_CONES}"),
+            (self.bounce_cones == 0 or 5 <= self.bounce_cones <= MAX_CONES,
+             f"bounce_cones {self.bounce_cones} must be 0 (= diffuse_cones) or 5..{MAX_CONES}"),
             (self.diffuse_aperture == 0 or 0 < self.diffuse_aperture < 90,
              f"diffuse_aperture {self.diffuse_aperture} must be 0 (derived) or in (0, 90) degrees"),
             (self.max_distance >= 0 and math.isfinite(self.max_distance), "max_distance must be ≥ 0 (0 = unlimited)"),
@@ -98,7 +105,7 @@ class VctSettings:
     def key(self, kind: str) -> tuple:
         """The settings a pass reads: 'bounce', 'trace' (diffuse cones per pixel, upsampling, accumulation) or
         'specular' (resolution and anisotropy key the earlier passes)."""
-        extra = {"bounce": CONE_FIELDS + ("bounces", "gathered_bounces"),
+        extra = {"bounce": CONE_FIELDS + ("bounce_cones", "bounces", "gathered_bounces"),
                  "trace": CONE_FIELDS + ("ao_distance", "indirect_scale", "cone_rotation", "temporal_frames"),
                  "specular": ("max_distance", "step_multiplier", "start_offset", "specular_cone",
                               "roughness_cutoff")}[kind]

@@ -3,6 +3,7 @@ plus readbacks for tests and statistics. Data types, settings and the injection 
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
@@ -51,7 +52,7 @@ def bounce(ctx, programs, vox, direct_faces: Faces, volumes: ConeVolumes, s: Vct
         unit = _units(prog, "u_direct", direct_faces.textures, unit)
         unit = _units(prog, "u_centroid", direct_faces.centroids, unit)
         _units(prog, "u_albedo", [vox.albedo], unit)
-        _cone_uniforms(prog, grid, volumes.levels, s, world)
+        _cone_uniforms(prog, grid, volumes.levels, replace(s, diffuse_cones=s.bounce_cones or s.diffuse_cones), world)
         for i, t in enumerate(faces.textures):
             t.bind_to_image(i, read=False, write=True)
         _dispatch(prog, grid.size)
