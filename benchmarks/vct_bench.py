@@ -6,7 +6,7 @@ is compared over the pixels where both Cycles' and our Glossy Color are non-zero
 column; rough Principled surfaces above the cutoff count, with our 0); `glossy_cornell` is the Cornell box with a Principled floor of roughness 0.1.
 
     .venv/bin/python benchmarks/vct_bench.py [--scenes cornell spot_room courtyard glossy_cornell]
-        [--grids 64 128] [--res 320x240 640x480] [--scales 1 2 4] [--bounces 1] [--samples 64] [--repeats 2]
+        [--grids 64 128] [--res 320x240 640x480] [--scales 1 2 4] [--bounces 8] [--samples 64] [--repeats 2]
 """
 import argparse
 import os
@@ -43,7 +43,7 @@ def main():
     parser.add_argument("--res", nargs="+", default=["320x240", "640x480"])
     parser.add_argument("--scales", nargs="+", type=int, default=[1], help="VctSettings.indirect_scale values")
     parser.add_argument("--specular", type=int, default=1, help="VctSettings.specular_cone (1 on, 0 off)")
-    parser.add_argument("--bounces", type=int, default=1, help="VCT bounces (VctSettings.bounces)")
+    parser.add_argument("--bounces", type=int, default=None, help="VCT bounces (default: VctSettings' default)")
     parser.add_argument("--anisotropic", type=int, default=1, help="1: anisotropic volumes (default), 0: isotropic")
     parser.add_argument("--samples", type=int, default=64, help="Cycles samples per seed (0: skip the errors)")
     parser.add_argument("--ref-bounces", type=int, default=8, help="Cycles bounces")
@@ -60,6 +60,8 @@ def main():
     from bounce_gi.gpu_kernels.pipeline import RenderSettings
     from bounce_gi.gpu_kernels.vct import VctSettings
 
+    if args.bounces is None:
+        args.bounces = VctSettings().bounces
     engine = Engine()
     print(f"GL: {engine.gl_info()['renderer']}; VCT bounces {args.bounces}, "
           f"{'anisotropic' if args.anisotropic else 'isotropic'}, specular cone {'on' if args.specular else 'off'}; "
