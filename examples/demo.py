@@ -20,7 +20,7 @@ def main() -> int:
     parser.add_argument("--scene", default="cornell")
     parser.add_argument("--res", nargs=2, type=int, default=(320, 240))
     parser.add_argument("--samples", type=int, default=128, help="Cycles samples per seed for the reference")
-    parser.add_argument("--methods", nargs="+", default=["none", "lpv"], choices=["none", "lpv", "vct"])
+    parser.add_argument("--methods", nargs="+", default=["none", "lpv", "vct"], choices=["none", "lpv", "vct"])
     args = parser.parse_args()
 
     import bpy

@@ -22,7 +22,9 @@ class BounceGISettings(PropertyGroup):
         name="Method",
         description="How indirect (bounced) light is computed",
         items=METHOD_ITEMS,
-        default="NONE",
+        # VCT: the most accurate against Cycles (benchmarks/results/llvmpipe/summary.md); the preview runs off the UI
+        # thread, so its cost on a slow GPU delays the image, not the interface.
+        default="VCT",
     )
     use_time_budget: BoolProperty(
         name="Time Budget",
