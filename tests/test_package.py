@@ -154,7 +154,7 @@ def test_register_unregister_twice(tmp_path):
             bounce_gi.register()
             assert hasattr(bpy.types.Scene, "bounce_gi") and hasattr(bpy.types, "BOUNCE_GI_OT_render_preview")
             s = bpy.context.scene.bounce_gi
-            assert (s.method, s.resolution_percentage, s.output_path) == ("NONE", 50, "//bounce_gi.exr")
+            assert (s.method, s.resolution_percentage, s.output_path) == ("VCT", 50, "//bounce_gi.exr")
             bounce_gi.unregister()
             assert not hasattr(bpy.types.Scene, "bounce_gi")
             assert not hasattr(bpy.types, "BOUNCE_GI_OT_render_preview")
