@@ -46,8 +46,10 @@ def bounce(ctx, programs, vox, direct_faces: Faces, volumes: ConeVolumes, s: Vct
     prog = programs.compute("vct_bounce.glsl", {"MODE_ANISO": None} if volumes.anisotropic else None)
     own, source, previous = None, volumes, None
     for b in range(2, gathered + 1):
-        if b == gathered and gathered < s.bounces:  # the tail needs the last increment L_K − L_(K−1)
-            previous = _read_faces(faces if b > 2 else direct_faces)
+        if b == gathered and gathered < s.bounces:  # the tail needs the last increment L_K − L_(K−1): keep L_(K−1)
+            previous = faces if b > 2 else direct_faces
+            if b > 2:
+                faces = Faces([_texture3d(ctx, grid.size, zero=True) for _ in range(6)], grid, direct_faces.levels)
         unit = _units(prog, "u_volume", source.textures, 0)
         unit = _units(prog, "u_direct", direct_faces.textures, unit)
         unit = _units(prog, "u_centroid", direct_faces.centroids, unit)
@@ -60,25 +62,23 @@ def bounce(ctx, programs, vox, direct_faces: Faces, volumes: ConeVolumes, s: Vct
         own = source = build_volumes(ctx, programs, faces, volumes.anisotropic, into=own)
         stats.append({"bounce": b, "flux": face_flux(ctx, programs, faces)[0]})
     if previous is not None:
-        stats.append(_extrapolate_tail(faces, previous, stats, s.bounces))
+        stats.append(_extrapolate_tail(ctx, programs, faces, previous, stats, s.bounces))
+        if previous is not direct_faces:
+            previous.release()
         own = build_volumes(ctx, programs, faces, volumes.anisotropic, into=own)
     own.faces, own.bounce_stats = faces, stats
     return own
 
 
-def _read_faces(faces: Faces) -> list:
-    return [np.frombuffer(t.read(), np.float32).reshape(t.depth, t.height, t.width, 4).copy()
-            for t in faces.textures]
-
-
-def _extrapolate_tail(faces: Faces, previous: list, stats: list, bounces: int) -> dict:
+def _extrapolate_tail(ctx, programs, faces: Faces, previous: Faces, stats: list, bounces: int) -> dict:
     """Bounces K+1 … N without gathering them: the light added by successive bounces of a Jacobi (power) iteration
     tends to a fixed shape that shrinks by a fixed ratio r per bounce (the dominant eigenvalue of the transport —
     in a white furnace of albedo ρ, exactly r = ρ). So with B_k the flux bounce k added (B_1 = the direct light's
     reflection) and r = B_K / B_(K−1) per RGB channel, the faces get
         L_N = L_K + (L_K − L_(K−1)) · Σ_{j=1}^{N−K} r^j
     — the increment's own spatial shape, summed as a geometric series up to the requested bounce count (truncated
-    like Cycles' bounce limit, not to infinity). Coverage α is kept. Returns the statistics row of the tail."""
+    like Cycles' bounce limit, not to infinity), in place on the GPU (vct_bounce_tail.glsl). Coverage α is kept.
+    Returns the statistics row of the tail."""
     k = len(stats)  # bounces gathered so far (stats[i] = after bounce i + 1)
     flux = [np.asarray(st["flux"], np.float64) for st in stats]
     added = [flux[0]] + [flux[i] - flux[i - 1] for i in range(1, k)]
@@ -87,10 +87,14 @@ def _extrapolate_tail(faces: Faces, previous: list, stats: list, bounces: int) -
     ratio = np.clip(np.nan_to_num(ratio), 0.0, 0.99)  # < 1: a passive scene cannot gain light per bounce
     n = bounces - k
     tail = ratio * (1.0 - ratio ** n) / (1.0 - ratio)
-    for t, prev in zip(faces.textures, previous):
-        cur = np.frombuffer(t.read(), np.float32).reshape(prev.shape).copy()
-        cur[..., :3] += (cur[..., :3] - prev[..., :3]) * tail.astype(np.float32)
-        t.write(cur.tobytes())
+    prog = programs.compute("vct_bounce_tail.glsl")
+    direct._set(prog, "u_grid_size", tuple(int(v) for v in faces.grid.size))
+    direct._set(prog, "u_tail", tuple(float(v) for v in tail))
+    for current, prev in zip(faces.textures, previous.textures):
+        _units(prog, "u_previous", [prev], 0)
+        current.bind_to_image(0, read=True, write=True)
+        _dispatch(prog, faces.grid.size)
+        ctx.memory_barrier()
     return {"bounce": bounces, "flux": [float(f) for f in flux[-1] + added[-1] * tail], "extrapolated": True,
             "ratio": [float(r) for r in ratio]}
 

@@ -119,7 +119,8 @@ def test_extrapolated_bounces_match_gathered_ones_in_the_furnace(engine, furnace
     texels leak per bounce: the gathered run shows B3/B2 = 0.481 at 32³, and the tail's estimate from bounces 1–2
     is 0.473, from 1–3 0.481 — so the ratio must lie in [0.45, ρ]. Tolerance on the result 1.5%: measured 0.98%
     low with 2 gathered bounces (the early ratio is a little low), 0.2% with 3."""
-    full = _render(engine, furnace, bounces=6)
+    full = _render(engine, furnace, bounces=6, gathered_bounces=0)  # every bounce gathered
+    assert len(full.info["bounces"]) == 6 and not full.info["bounces"][-1].get("extrapolated")
     hit = full.passes["Depth"][..., 0] < 1e9
     reference = float(full.passes["Diffuse Indirect"][hit].mean())
     for gathered in (2, 3):
