@@ -35,3 +35,15 @@ def compare_examples(reference_cache, tmp_path_factory):
         return data
 
     return run
+
+
+@pytest.fixture(scope="session")
+def check_bounds():
+    """check(report, bounds): every rel-L1 in `bounds` is within its bound, and Diffuse Direct — the same direct
+    light for every method, its own accuracy tested in test_direct_vs_cycles — within 3%."""
+    def check(report, bounds):
+        for key, bound in bounds.items():
+            assert report["rel_l1"][key] <= bound, (key, report["rel_l1"], report["noise_floor"])
+        assert report["rel_l1"]["diffuse_direct"] <= 0.03
+
+    return check

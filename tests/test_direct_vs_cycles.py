@@ -9,15 +9,8 @@ Tolerances are the claims:
 - Diffuse Color: ≥ 98% of geometry pixels within 0.01 of Cycles. Only pixels on silhouettes and on edges where two
   materials meet may differ (Cycles jitters within ±0.005 px of the centre), about 1% of the pixels here.
 """
-import json
-import os
-import subprocess
-import sys
-from pathlib import Path
-
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
 LIGHT_SCENES = ["light_sun", "light_point", "light_point_soft", "light_spot", "light_area_square",
                 "light_area_disk", "light_mixed", "cornell", "cornell_emissive"]
 CAMERA_SCENES = ["textured", "principled", "camera_shift", "camera_ortho"]
@@ -28,15 +21,8 @@ NOISE_FLOOR_LIMIT = 0.01  # a reference noisier than this could hide a 3% error
 
 
 @pytest.fixture(scope="module")
-def results(tmp_path_factory):
-    cache = tmp_path_factory.mktemp("refcache")
-    env = dict(os.environ, BOUNCE_GI_CACHE=os.environ.get("BOUNCE_GI_TEST_CACHE", str(cache)),
-               BLENDER_USER_RESOURCES=str(tmp_path_factory.mktemp("blender_user")))
-    proc = subprocess.run([sys.executable, str(ROOT / "tests/support/compare_examples.py"), str(SAMPLES),
-                           *LIGHT_SCENES, *CAMERA_SCENES], capture_output=True, text=True, env=env, timeout=900)
-    line = next((l for l in proc.stdout.splitlines() if l.startswith("RESULT ")), None)
-    assert proc.returncode == 0 and line, f"comparison run failed:\n{proc.stdout[-3000:]}\n{proc.stderr[-3000:]}"
-    data = json.loads(line[len("RESULT "):])
+def results(compare_examples):
+    data = compare_examples(SAMPLES, LIGHT_SCENES + CAMERA_SCENES)
     for name, r in data.items():  # shown with -s or on failure: the measured numbers
         print(f"{name:<20} DiffDir rel-L1 {r['rel_l1']['diffuse_direct']:.4f} (floor {r['noise_floor']['diffuse_direct']:.4f})"
               f"  DiffCol match {r['diffuse_color_match']:.4f}")

@@ -35,18 +35,11 @@ def one_bounce(compare_examples):
     return compare_examples(128, list(ONE_BOUNCE), "--method", "lpv", "--bounces", 1, "--lpv", "bounces=1")
 
 
-def _check(r, bounds):
-    for key, bound in bounds.items():
-        assert r["rel_l1"][key] <= bound, (key, r["rel_l1"], r["noise_floor"])
-    # The direct light is the same as method 'none' (its own accuracy is tested in test_direct_vs_cycles).
-    assert r["rel_l1"]["diffuse_direct"] <= 0.03
-
-
 @pytest.mark.parametrize("name", list(FULL))
-def test_lpv_full_bounce_error_does_not_regress(full, name):
-    _check(full[name], FULL[name])
+def test_lpv_full_bounce_error_does_not_regress(full, name, check_bounds):
+    check_bounds(full[name], FULL[name])
 
 
 @pytest.mark.parametrize("name", list(ONE_BOUNCE))
-def test_lpv_one_bounce_error_does_not_regress(one_bounce, name):
-    _check(one_bounce[name], ONE_BOUNCE[name])
+def test_lpv_one_bounce_error_does_not_regress(one_bounce, name, check_bounds):
+    check_bounds(one_bounce[name], ONE_BOUNCE[name])
