@@ -204,9 +204,11 @@ def _texture3d(ctx, size, levels: int = 1, zero: bool = False):
     stores are slow: storing 12 zeros to every empty voxel took 1 s of vct_inject at 128³)."""
     import moderngl
 
-    size = tuple(int(n) for n in size)
-    data = np.zeros(size[::-1] + (4,), np.float32).tobytes() if zero else None
-    t = ctx.texture3d(size, 4, data, dtype="f4")
+    from .gpu_context import zero_texture
+
+    t = ctx.texture3d(tuple(int(n) for n in size), 4, None, dtype="f4")
+    if zero:
+        zero_texture(ctx, t)
     t.repeat_x = t.repeat_y = t.repeat_z = False
     if levels > 1:
         t.build_mipmaps(0, levels - 1)  # allocates the chain; every level is then overwritten by vct_mipmap.glsl
@@ -284,16 +286,17 @@ def inject(ctx, programs, scene: Scene, geometry, textures: list, vox, shadows, 
             fbo.release()
         ctx.memory_barrier()
 
-        prog = programs.compute("vct_inject.glsl", {"MODE_RESOLVE": None})
-        unit = _units(prog, "u_area", [vox.area], 0)
-        unit = _units(prog, "u_albedo", [vox.albedo], unit)
-        unit = _units(prog, "u_acc", [acc], unit)
-        _light_uniforms(prog, shadows, unit)
-        _grid_uniforms(prog, grid)
-        for i, t in enumerate(faces.textures + faces.centroids):
-            t.bind_to_image(i, read=False, write=True)
-        _dispatch(prog, grid.size)
-        ctx.memory_barrier()
+        for outputs, defines in ((faces.textures, {}), (faces.centroids, {"WRITE_CENTROIDS": None})):
+            prog = programs.compute("vct_inject.glsl", {"MODE_RESOLVE": None, **defines})
+            unit = _units(prog, "u_area", [vox.area], 0)
+            unit = _units(prog, "u_albedo", [vox.albedo], unit)
+            unit = _units(prog, "u_acc", [acc], unit)
+            _light_uniforms(prog, shadows, unit)
+            _grid_uniforms(prog, grid)
+            for i, t in enumerate(outputs):
+                t.bind_to_image(i, read=False, write=True)
+            _dispatch(prog, grid.size)
+            ctx.memory_barrier()
     finally:
         acc.release()
     faces.flux, faces.occupied, faces.missed = face_flux(ctx, programs, faces)

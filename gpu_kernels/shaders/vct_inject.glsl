@@ -37,11 +37,11 @@ uniform int u_light_count;
 uniform sampler3D u_area;        // voxelize(): rgb projected areas (m²), a total area
 uniform sampler3D u_albedo;      // rgb mean diffuse albedo
 uniform usampler3D u_acc;        // vct_inject_raster.glsl's sums (float bits)
-layout(rgba32f, binding = 0) uniform writeonly image3D u_face[6];       // +x, −x, +y, −y, +z, −z
-layout(rgba32f, binding = 6) uniform writeonly image3D u_centroid[6];
+// Six images per dispatch, not twelve: NVIDIA drivers allow 8 image units per stage (GL_MAX_IMAGE_UNITS, the
+// spec's minimum; Mesa allows 32), so vct.inject() runs this twice — faces, then centroids (WRITE_CENTROIDS).
+layout(rgba32f, binding = 0) uniform writeonly image3D u_out[6];       // +x, −x, +y, −y, +z, −z
 #include "vct_arrays.glsl"
-VCT_STORE6(store_face, u_face)
-VCT_STORE6(store_centroid, u_centroid)
+VCT_STORE6(store_out, u_out)
 
 float acc(int g, ivec3 v, int c) {
     return uintBitsToFloat(texelFetch(u_acc, ivec3(8 * v.x + c, v.y, g * u_grid_size.z + v.z), 0).r);
@@ -71,8 +71,11 @@ void main() {
             radiance = texelFetch(u_albedo, v, 0).rgb * e / PI;
             surface.w = -alpha;
         }
-        store_face(g, v, vec4(radiance, alpha));
-        store_centroid(g, v, surface);
+#if defined(WRITE_CENTROIDS)
+        store_out(g, v, surface);
+#else
+        store_out(g, v, vec4(radiance, alpha));
+#endif
     }
 }
 #endif
