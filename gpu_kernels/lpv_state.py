@@ -10,6 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import direct
+from .gpu_context import zero_texture
 from .grid import Grid
 
 FAR_FACE = 0.4006696846  # solid angle of the far face of the next cell, seen from a cell centre (design.md §3)
@@ -117,7 +118,7 @@ def _volumes(ctx, grid: Grid, data: np.ndarray | None = None) -> Volumes:
         texs.append(t)
     if data is None:
         for t in texs:
-            t.write(np.zeros(size[::-1] + (4,), np.float32).tobytes())
+            zero_texture(ctx, t)
     return Volumes(*texs)
 
 
