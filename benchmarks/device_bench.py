@@ -68,13 +68,10 @@ def _load(scene_dir, name, w, h):
 
 
 def _timed(engine, scene, settings, repeats):
-    engine.render(scene, settings)  # warm-up: compiles shaders
-    runs = []
-    for _ in range(repeats):
-        engine.worker.call(lambda ctx: engine._pipeline.cache.clear())
-        start = time.perf_counter()
-        result = engine.render(scene, settings)
-        runs.append((time.perf_counter() - start, result))
+    """(median seconds, runs) of lpv_bench's warm-up-then-repeat timing."""
+    from benchmarks.lpv_bench import _timed as timed_runs
+
+    runs = timed_runs(engine, scene, settings, repeats)
     return statistics.median(r[0] for r in runs), runs
 
 
