@@ -85,14 +85,11 @@ def _errors(result, ref):
                                                                                          "Combined"))
 
 
-def run(scene_dir, grids, lpv_grids, repeats, say):
-    from bounce_gi.gpu_kernels.engine import Engine
+def run(engine, scene_dir, grids, lpv_grids, repeats, say):
     from bounce_gi.gpu_kernels.lpv import LpvSettings
     from bounce_gi.gpu_kernels.pipeline import RenderSettings
     from bounce_gi.gpu_kernels.vct import VctSettings
 
-    engine = Engine()
-    say(f"GL: {engine.gl_info()['renderer']}; median of {repeats} after a warm-up; ms")
     say(f"\nVCT (defaults: {VctSettings().bounces} bounces, {VctSettings().gathered_bounces} gathered)")
     say(f"{'scene':<11}{'grid':>6}{'image':>9}" + "".join(f"{p[4:]:>10}" for p in VCT_PASSES) +
         f"{'total':>9}{'DI relL1':>11}{'Comb relL1':>11}")
@@ -150,9 +147,8 @@ def _edited(scene, kind, sign):
     return out
 
 
-def incremental(scene_dir, repeats, say):
+def incremental(engine, scene_dir, repeats, say):
     """Median seconds of one update after an edit in a long-lived engine (pass cache kept), per kind."""
-    from bounce_gi.gpu_kernels.engine import Engine
     from bounce_gi.gpu_kernels.lpv import LpvSettings
     from bounce_gi.gpu_kernels.pipeline import RenderSettings
     from bounce_gi.gpu_kernels.vct import VctSettings
@@ -160,7 +156,6 @@ def incremental(scene_dir, repeats, say):
     kinds = ("unchanged", "camera_only", "light_move", "material_change")
     say("\nIncremental updates (pass cache kept; median of %d edits, alternately +0.05 and −0.05), ms" % repeats)
     say(f"{'scene':<11}{'method':<14}{'full':>9}" + "".join(f"{k:>17}" for k in kinds))
-    engine = Engine()
     w, h = ERROR_RES
     for name in SCENES:
         scene, _ = _load(scene_dir, name, w, h)
@@ -202,10 +197,14 @@ def main():
                 log.write(line + "\n")
                 log.flush()
 
+            from bounce_gi.gpu_kernels.engine import Engine
+
+            engine = Engine()  # one context: the incremental part reuses the compiled shaders
+            say(f"GL: {engine.gl_info()['renderer']}; median of {args.repeats} after a warm-up; ms")
             if args.only != "incremental":
-                run(args.dir, args.grids, args.lpv_grids, args.repeats, say)
+                run(engine, args.dir, args.grids, args.lpv_grids, args.repeats, say)
             if args.only != "tables":
-                incremental(args.dir, args.repeats, say)
+                incremental(engine, args.dir, args.repeats, say)
 
 
 if __name__ == "__main__":
