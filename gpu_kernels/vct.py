@@ -29,17 +29,21 @@ from . import direct
 from .grid import Grid
 from .scene import Scene
 
-MAX_CONES = 9  # vct_common.glsl
+MAX_CONES = 32  # vct_common.glsl (cone_table makes at most 31)
 CONE_FIELDS = ("diffuse_cones", "diffuse_aperture", "max_distance", "step_multiplier", "start_offset")
 
 
 @dataclass(frozen=True)
 class VctSettings:
     resolution: int = 64  # voxels along the longest axis of the scene (other axes padded, see vct_grid)
-    # 1 around the normal + (n − 1) in a ring; 5..9 (cone_table). Default 9, measured (64³, 8 bounces of which 3
-    # gathered, 160×120, against 8-bounce Cycles): Cornell Diffuse Indirect rel-L1 0.197 vs 0.239 with 6 — fewer, wider cones leave
-    # lobe-shaped bright and dark patches on walls facing a lit surface.
-    diffuse_cones: int = 9
+    # A cap around the normal and one ring (5..9) or two rings (13, 16, … 31), cone_table. Default 19, measured
+    # (64³, defaults otherwise, 160×120, against 2048-spp 8-bounce Cycles; Diffuse Indirect / Combined rel-L1 over
+    # cone_rotation 0, 11.25, 22.5°): Cornell 0.149–0.150 / 0.075 (9 cones: 0.167–0.173 / 0.084–0.087), spot room
+    # 0.135–0.139 / 0.049–0.051 (9: 0.108–0.122 / 0.040–0.044), courtyard 0.244–0.281 / 0.169–0.194 (9: 0.237–0.292
+    # / 0.165–0.202); 13 cones swung more with the rotation (Cornell 0.147–0.159, courtyard 0.190–0.287). Wider
+    # cones over-weight what lies on their axis (cone_table); the per-pixel trace costs about twice 9 cones', the
+    # bounce gathers (bounce_cones) are unchanged.
+    diffuse_cones: int = 19
     # Cones per voxel face in the bounce gathers (vct_bounce); 0 = diffuse_cones. Bounced light is smooth, and
     # these gathers are most of a multi-bounce frame's time. Default 6, measured against 9 (64³, defaults otherwise,
     # Combined rel-L1 / bounce pass on llvmpipe): Cornell 0.092 vs 0.093 / 3.6 s vs 4.9 s, spot room 0.053 vs
@@ -81,9 +85,10 @@ class VctSettings:
     def __post_init__(self):
         checks = [
             (16 <= self.resolution <= 512, f"resolution {self.resolution} out of range 16..512"),
-            (5 <= self.diffuse_cones <= MAX_CONES, f"diffuse_cones {self.diffuse_cones} out of range 5..{MAX_CONES}"),
-            (self.bounce_cones == 0 or 5 <= self.bounce_cones <= MAX_CONES,
-             f"bounce_cones {self.bounce_cones} must be 0 (= diffuse_cones) or 5..{MAX_CONES}"),
+            (_valid_cone_count(self.diffuse_cones), f"diffuse_cones {self.diffuse_cones} must be 5..9 or 13, 16, "
+             f"19, … {MAX_CONES - 1}"),
+            (self.bounce_cones == 0 or _valid_cone_count(self.bounce_cones),
+             f"bounce_cones {self.bounce_cones} must be 0 (= diffuse_cones), 5..9 or 13, 16, 19, … {MAX_CONES - 1}"),
             (self.diffuse_aperture == 0 or 0 < self.diffuse_aperture < 90,
              f"diffuse_aperture {self.diffuse_aperture} must be 0 (derived) or in (0, 90) degrees"),
             (self.max_distance >= 0 and math.isfinite(self.max_distance), "max_distance must be ≥ 0 (0 = unlimited)"),
@@ -113,27 +118,63 @@ class VctSettings:
         return tuple((name, d[name]) for name in extra)
 
 
+def _valid_cone_count(count) -> bool:
+    try:
+        ring_sizes(count)
+        return True
+    except (TypeError, ValueError):
+        return False
+
+
+def ring_sizes(count: int) -> list[int]:
+    """Regions of the diffuse cone set, from the normal outward: [1, n − 1] for 5..9 cones (a cap and one ring),
+    [1, m, 2m] for n = 1 + 3m, m = 4..10 (13, 16, … 31 cones: a cap and two rings, the outer one twice as many
+    sectors so every region keeps about the same shape). Anything else is not a valid count."""
+    n = int(count)
+    if 5 <= n <= 9:
+        return [1, n - 1]
+    if (n - 1) % 3 == 0 and 4 <= (n - 1) // 3 <= (MAX_CONES - 1) // 3:
+        return [1, (n - 1) // 3, 2 * (n - 1) // 3]
+    raise ValueError(f"diffuse_cones {n}: must be 5..9, or 13, 16, 19, … {MAX_CONES - 1} (1 + 3m, two rings)")
+
+
 def cone_table(count: int, aperture_deg: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Diffuse cones: (unit directions (n, 3) in the normal's frame, z = normal; weights (n,); tan(half-angle) (n,)).
 
-    The hemisphere is cut into n regions of equal solid angle 2π/n: a polar cap θ < θ₁ with 1 − cosθ₁ = 1/n, and
-    n − 1 equal azimuthal sectors of the ring θ₁ ≤ θ ≤ π/2. Cone k stands for region k:
-      weight  w_k = ∫_region cosθ dω:  cap π·sin²θ₁, each sector π·cos²θ₁/(n − 1); Σ w_k = π exactly, so a uniform
-              radiance L gives E = Σ w_k·L = π·L, the exact cosine-weighted hemisphere integral;
-      axis    the region's cosine-weighted mean direction: the normal for the cap; for a sector of width Δφ = 2π/m
-              (m = n − 1), tilted by atan2(2·sin(π/m)·(1 − sin³θ₁), Δφ·cos³θ₁) from the normal
-              (∫ sin²θ cosθ dθ and ∫ cos²θ sinθ dθ over [θ₁, π/2]);
-      aperture half-angle of a cone of the region's solid angle, acos(1 − 1/n) (33.56° for n = 6), unless given.
+    The hemisphere is cut into n regions of equal solid angle 2π/n: a polar cap, then one or two rings
+    (ring_sizes) each cut into m equal azimuthal sectors; the boundaries fall where the solid angle above them is
+    a whole number of regions, 1 − cosθ_k = (regions so far)/n. Cone k stands for region k (ring [θa, θb], width
+    Δφ = 2π/m):
+      weight  w_k = ∫_region cosθ dω = Δφ·(sin²θb − sin²θa)/2; Σ w_k = π exactly, so a uniform radiance L gives
+              E = Σ w_k·L = π·L, the exact cosine-weighted hemisphere integral;
+      axis    the region's cosine-weighted mean direction: the normal for the cap; for a sector tilted by
+              atan2(2·sin(Δφ/2)·(sin³θb − sin³θa), Δφ·(cos³θa − cos³θb)) from the normal (∫ sin²θ cosθ dθ and
+              ∫ cos²θ sinθ dθ over the ring); the second ring is turned half a sector against the first;
+      aperture half-angle of a cone of the region's solid angle, acos(1 − 1/n) (27.3° for 9 cones, 18.7° for 19),
+              unless given.
+    Why two rings (measured, 64³, 160×120, against 2048-spp Cycles): a cone's mip level is capped by its height
+    above the surface it starts from (vct_common.glsl), so a wide cone reads a footprint narrower than itself and
+    over-weights what lies on its axis. 9 cones of 27° gave Cornell one-bounce Diffuse Indirect rel-L1 0.268
+    (mean 1.12× of one-bounce Cycles), 19 cones of 18.7° 0.159 (1.06×).
     """
-    n, m = int(count), int(count) - 1
-    cos1 = 1.0 - 1.0 / n
-    sin1 = math.sqrt(1.0 - cos1 * cos1)
-    tilt = math.atan2(2.0 * math.sin(math.pi / m) * (1.0 - sin1 ** 3), (2.0 * math.pi / m) * cos1 ** 3)
-    dirs = [(0.0, 0.0, 1.0)]
-    for k in range(m):
-        phi = 2.0 * math.pi * k / m
-        dirs.append((math.sin(tilt) * math.cos(phi), math.sin(tilt) * math.sin(phi), math.cos(tilt)))
-    weights = [math.pi * sin1 ** 2] + [math.pi * cos1 ** 2 / m] * m
+    n = int(count)
+    dirs, weights = [], []
+    done, cos_a = 0, 1.0
+    for ring, m in enumerate(ring_sizes(n)):
+        done += m
+        cos_b = 1.0 - done / n
+        sin_a, sin_b = math.sqrt(max(0.0, 1.0 - cos_a * cos_a)), math.sqrt(max(0.0, 1.0 - cos_b * cos_b))
+        dphi = 2.0 * math.pi / m
+        weight = dphi * (sin_b ** 2 - sin_a ** 2) / 2.0
+        if m == 1:
+            dirs.append((0.0, 0.0, 1.0))
+        else:
+            tilt = math.atan2(2.0 * math.sin(dphi / 2.0) * (sin_b ** 3 - sin_a ** 3), dphi * (cos_a ** 3 - cos_b ** 3))
+            turn = 0.5 * dphi if ring == 2 else 0.0
+            dirs += [(math.sin(tilt) * math.cos(turn + k * dphi), math.sin(tilt) * math.sin(turn + k * dphi),
+                      math.cos(tilt)) for k in range(m)]
+        weights += [weight] * m
+        cos_a = cos_b
     half = math.radians(aperture_deg) if aperture_deg > 0 else math.acos(1.0 - 1.0 / n)
     return np.array(dirs), np.array(weights), np.full(n, math.tan(half))
 

@@ -14,7 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from . import direct
-from .vct import VctSettings, _units
+from .vct import VctSettings, _units, ring_sizes
 
 
 def radical_inverse(k: int) -> float:
@@ -29,8 +29,9 @@ def radical_inverse(k: int) -> float:
 
 def jitter_deg(s: VctSettings, frame: int) -> float:
     """The cone set's turn about the normal (degrees) for accumulation frame `frame`: s.cone_rotation plus a
-    van der Corput fraction of the ring spacing 360°/(cones − 1) (a turn by the spacing gives the same set)."""
-    return s.cone_rotation + 360.0 / (s.diffuse_cones - 1) * radical_inverse(frame)
+    van der Corput fraction of the first ring's spacing 360°/m (a turn by it gives the same set: the second ring,
+    if any, has 2m sectors)."""
+    return s.cone_rotation + 360.0 / ring_sizes(s.diffuse_cones)[1] * radical_inverse(frame)
 
 
 @dataclass

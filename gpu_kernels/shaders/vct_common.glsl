@@ -7,7 +7,7 @@
 // travelling that way sees (vct_mipmap.glsl). Otherwise one isotropic volume.
 #pragma once
 
-#define MAX_CONES 9
+#define MAX_CONES 32
 #define MAX_STEPS 1024
 #define MIN_TRANSMITTANCE 1e-3   // stop a cone when < 0.1% of it is left: the error is below 0.1% of its radiance
 
