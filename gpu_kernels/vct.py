@@ -115,6 +115,8 @@ class VctSettings:
                  "specular": ("max_distance", "step_multiplier", "start_offset", "specular_cone",
                               "roughness_cutoff")}[kind]
         d = asdict(self)
+        if kind == "bounce" and self.bounce_cones:  # the gathers at voxel faces use bounce_cones, not diffuse_cones
+            extra = tuple(name for name in extra if name != "diffuse_cones")
         return tuple((name, d[name]) for name in extra)
 
 

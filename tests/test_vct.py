@@ -314,6 +314,10 @@ def test_defaults_are_valid_and_keys_separate_passes():
         assert VctSettings(**change).key("trace") == s.key("trace")
         assert VctSettings(**change).key("bounce") != s.key("bounce")
     assert VctSettings(ao_distance=1.0).key("bounce") == s.key("bounce")
+    # The bounce gathers use bounce_cones; diffuse_cones only when bounce_cones = 0 ("same as diffuse").
+    assert VctSettings(diffuse_cones=9).key("bounce") == s.key("bounce")
+    assert VctSettings(diffuse_cones=9).key("trace") != s.key("trace")
+    assert VctSettings(diffuse_cones=9, bounce_cones=0).key("bounce") != VctSettings(bounce_cones=0).key("bounce")
     assert s.specular_cone  # on by default: pixels with no glossy closure skip it (vct_specular.py)
     for change in (dict(indirect_scale=2), dict(temporal_frames=4), dict(cone_rotation=10.0)):
         assert VctSettings(**change).key("trace") != s.key("trace") and VctSettings(**change).key("specular") == \
