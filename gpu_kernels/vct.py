@@ -6,7 +6,8 @@ Passes (pipeline.py wires them into the pass cache):
                 Direct pass lights pixels (direct_eval.glsl), averaged into six faces per voxel: the radiance
                 leaving through each face, its coverage and where its surfaces lie (vct_inject*.glsl);
   vct_mipmap    the filtered radiance volumes: isotropic (mean of children) or anisotropic (six directions,
-                composited front to back) (vct_mipmap.glsl, seed 004 §4.4);
+                composited front to back, plus where each texel's surfaces lie along each axis, so a cone skips
+                surfaces behind where it started) (vct_mipmap.glsl, seed 004 §4.4);
   vct_bounce    bounces − 1 gathers at the voxel faces, each followed by a re-mip (vct_bounce.glsl);
   vct_trace     diffuse cones per G-buffer pixel (or per s × s block, indirect_scale) → Diffuse Indirect and voxel
                 AO (vct_trace.glsl, seed 004 §4.5.2);
@@ -15,7 +16,7 @@ Passes (pipeline.py wires them into the pass cache):
   vct_specular  one glossy cone per pixel → Glossy Indirect (vct_specular.py).
 
 Every scale is derived; the shaders' comments give the derivations (self-occlusion bound, step opacity, anisotropic
-optical depth), `cone_table` gives the cones'. Sky light: the world colour fills what is left of every cone that
+optical depth, the layer test), `cone_table` gives the cones'. Sky light: the world colour fills what is left of every cone that
 leaves the grid; it lands in Diffuse Indirect here, whereas Cycles counts world light as Diffuse Direct.
 """
 from __future__ import annotations
@@ -38,11 +39,11 @@ class VctSettings:
     resolution: int = 64  # voxels along the longest axis of the scene (other axes padded, see vct_grid)
     # A cap around the normal and one ring (5..9) or two rings (13, 16, … 31), cone_table. Default 19, measured
     # (64³, defaults otherwise, 160×120, against 2048-spp 8-bounce Cycles; Diffuse Indirect / Combined rel-L1 over
-    # cone_rotation 0, 11.25, 22.5°): Cornell 0.149–0.150 / 0.075 (9 cones: 0.167–0.173 / 0.084–0.087), spot room
-    # 0.135–0.139 / 0.049–0.051 (9: 0.108–0.122 / 0.040–0.044), courtyard 0.244–0.281 / 0.169–0.194 (9: 0.237–0.292
-    # / 0.165–0.202); 13 cones swung more with the rotation (Cornell 0.147–0.159, courtyard 0.190–0.287). Wider
-    # cones over-weight what lies on their axis (cone_table); the per-pixel trace costs about twice 9 cones', the
-    # bounce gathers (bounce_cones) are unchanged.
+    # cone_rotation 0, 11.25, 22.5°): Cornell 0.137–0.141 / 0.070–0.072 (9 cones: 0.166–0.173 / 0.084–0.087; 13:
+    # 0.141–0.146 / 0.072–0.074), spot room 0.131–0.133 / 0.048–0.050 (9: 0.112–0.124 / 0.041–0.045; 13: 0.118–0.138
+    # / 0.044–0.050), courtyard 0.176–0.179 / 0.124–0.125 (9: 0.223–0.229 / 0.155–0.159; 13: 0.168–0.201 /
+    # 0.118–0.141). Wider cones over-weight what lies on their axis (cone_table), and fewer swing more with the
+    # cone set's turn; the per-pixel trace costs about 2.2× 9 cones', the bounce gathers (bounce_cones) are unchanged.
     diffuse_cones: int = 19
     # Cones per voxel face in the bounce gathers (vct_bounce); 0 = diffuse_cones. Bounced light is smooth, and
     # these gathers are most of a multi-bounce frame's time. Default 6, measured against 9 (64³, defaults otherwise,
@@ -156,8 +157,8 @@ def cone_table(count: int, aperture_deg: float = 0.0) -> tuple[np.ndarray, np.nd
               unless given.
     Why two rings (measured, 64³, 160×120, against 2048-spp Cycles): a cone's mip level is capped by its height
     above the surface it starts from (vct_common.glsl), so a wide cone reads a footprint narrower than itself and
-    over-weights what lies on its axis. 9 cones of 27° gave Cornell one-bounce Diffuse Indirect rel-L1 0.268
-    (mean 1.12× of one-bounce Cycles), 19 cones of 18.7° 0.159 (1.06×).
+    over-weights what lies on its axis. 9 cones of 27° gave Cornell one-bounce Diffuse Indirect rel-L1 0.23–0.27
+    (mean 1.09–1.12× of one-bounce Cycles), 19 cones of 18.7° 0.16 (1.06×) (before cone_step's layer test).
     """
     n = int(count)
     dirs, weights = [], []
@@ -233,6 +234,10 @@ class ConeVolumes:
     owned: bool = True
     faces: Faces | None = None  # the bounced face radiance these volumes were built from (vct_bounce only)
     bounce_stats: list = None
+    # Anisotropic: where each texel's surfaces lie along each axis (vct_mipmap.glsl MODE_LAYERS). Geometry only, so
+    # the bounce passes share the direct light's (layers_owned False).
+    layers: object = None
+    layers_owned: bool = True
 
     def release(self):
         if self.owned:
@@ -240,6 +245,8 @@ class ConeVolumes:
                 t.release()
             if self.faces is not None:
                 self.faces.release()
+            if self.layers is not None and self.layers_owned:
+                self.layers.release()
 
 
 def _texture3d(ctx, size, levels: int = 1, zero: bool = False):
@@ -378,8 +385,10 @@ def face_flux(ctx, programs, faces: Faces) -> tuple[list, int, int]:
     return [float(c) for c in flux], int(round(rows[:, 0, 3].sum())), int(round(rows[:, 1, 0].sum()))
 
 
-def build_volumes(ctx, programs, faces: Faces, anisotropic: bool, into: ConeVolumes | None = None) -> ConeVolumes:
-    """Level 0 from the face radiances, then each level from the one below (vct_mipmap.glsl, seed 004 §4.4).
+def build_volumes(ctx, programs, faces: Faces, anisotropic: bool, into: ConeVolumes | None = None,
+                  layers=None) -> ConeVolumes:
+    """Level 0 from the face radiances, then each level from the one below (vct_mipmap.glsl, seed 004 §4.4), and,
+    anisotropic, the layer volume (from faces.centroids, or `layers` shared from the volumes of the same geometry).
     `into`: rebuild existing volumes in place (vct_bounce) instead of allocating new ones."""
     grid = faces.grid
     sizes = level_sizes(grid, faces.levels)
@@ -403,7 +412,32 @@ def build_volumes(ctx, programs, faces: Faces, anisotropic: bool, into: ConeVolu
         direct._set(prog, "u_level", level)
         _dispatch(prog, sizes[level])
         ctx.memory_barrier()
+    if anisotropic and layers is not None:
+        vols.layers, vols.layers_owned = layers, False
+    elif anisotropic and vols.layers is None:
+        vols.layers, vols.layers_owned = build_layers(ctx, programs, faces, vols), True
     return vols
+
+
+def build_layers(ctx, programs, faces: Faces, vols: ConeVolumes):
+    """The layer volume of anisotropic `vols` (vct_mipmap.glsl MODE_LAYERS), every level."""
+    grid = faces.grid
+    sizes = level_sizes(grid, vols.levels)
+    layers = _texture3d(ctx, grid.size, len(sizes))
+    prog = programs.compute("vct_mipmap.glsl", {"MODE_LAYERS": None})
+    unit = _units(prog, "u_src", vols.textures, 0)
+    unit = _units(prog, "u_centroid", faces.centroids or faces.textures, unit)
+    _units(prog, "u_layers_src", [layers], unit)
+    direct._set(prog, "u_has_centroids", faces.centroids is not None)
+    direct._set(prog, "u_grid_origin", tuple(float(c) for c in grid.origin))
+    direct._set(prog, "u_cell", float(grid.cell))
+    for level, size in enumerate(sizes):
+        layers.bind_to_image(0, read=False, write=True, level=level)
+        direct._set(prog, "u_dst_size", size)
+        direct._set(prog, "u_level", level)
+        _dispatch(prog, size)
+        ctx.memory_barrier()
+    return layers
 
 
 # The cone passes live in vct_cones.py (vct.py stays a readable size); re-exported here for pipeline.py and tests.

@@ -40,7 +40,7 @@ def bounce(ctx, programs, vox, direct_faces: Faces, volumes: ConeVolumes, s: Vct
     gathered = s.bounces if not s.gathered_bounces else min(s.gathered_bounces, s.bounces)
     if gathered <= 1:
         return ConeVolumes(volumes.textures, volumes.grid, volumes.levels, volumes.anisotropic, owned=False,
-                           bounce_stats=stats)
+                           bounce_stats=stats, layers=volumes.layers, layers_owned=False)
     grid = direct_faces.grid
     faces = Faces([_texture3d(ctx, grid.size, zero=True) for _ in range(6)], grid, direct_faces.levels)
     prog = programs.compute("vct_bounce.glsl", {"MODE_ANISO": None} if volumes.anisotropic else None)
@@ -51,6 +51,7 @@ def bounce(ctx, programs, vox, direct_faces: Faces, volumes: ConeVolumes, s: Vct
             if b > 2:
                 faces = Faces([_texture3d(ctx, grid.size, zero=True) for _ in range(6)], grid, direct_faces.levels)
         unit = _units(prog, "u_volume", source.textures, 0)
+        unit = _units(prog, "u_layers", [volumes.layers] if volumes.layers is not None else [], unit)
         unit = _units(prog, "u_direct", direct_faces.textures, unit)
         unit = _units(prog, "u_centroid", direct_faces.centroids, unit)
         _units(prog, "u_albedo", [vox.albedo], unit)
@@ -59,13 +60,13 @@ def bounce(ctx, programs, vox, direct_faces: Faces, volumes: ConeVolumes, s: Vct
             t.bind_to_image(i, read=False, write=True)
         _dispatch(prog, grid.size)
         ctx.memory_barrier()
-        own = source = build_volumes(ctx, programs, faces, volumes.anisotropic, into=own)
+        own = source = build_volumes(ctx, programs, faces, volumes.anisotropic, into=own, layers=volumes.layers)
         stats.append({"bounce": b, "flux": face_flux(ctx, programs, faces)[0]})
     if previous is not None:
         stats.append(_extrapolate_tail(ctx, programs, faces, previous, stats, s.bounces))
         if previous is not direct_faces:
             previous.release()
-        own = build_volumes(ctx, programs, faces, volumes.anisotropic, into=own)
+        own = build_volumes(ctx, programs, faces, volumes.anisotropic, into=own, layers=volumes.layers)
     own.faces, own.bounce_stats = faces, stats
     return own
 
@@ -135,6 +136,7 @@ def _trace_program(programs, gbuffer, faces, volumes, s, world, rotation_deg, fi
         defines["MODE_FIXUP"] = None
     prog = programs.compute("vct_trace.glsl", defines or None)
     unit = _units(prog, "u_volume", volumes.textures, 0)
+    unit = _units(prog, "u_layers", [volumes.layers] if volumes.layers is not None else [], unit)
     unit = _units(prog, "u_centroid", faces.centroids, unit)
     for name in ("position", "normal", "geo_normal"):
         unit = _units(prog, f"u_{name}", [gbuffer.textures[name]], unit)

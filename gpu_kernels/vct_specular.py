@@ -37,6 +37,7 @@ def specular(ctx, programs, gbuffer, faces: Faces, volumes: ConeVolumes, s: VctS
         return {"glossy": out, "traced": 0}
     prog = programs.compute("vct_specular.glsl", {"MODE_ANISO": None} if volumes.anisotropic else None)
     unit = _units(prog, "u_volume", volumes.textures, 0)
+    unit = _units(prog, "u_layers", [volumes.layers] if volumes.layers is not None else [], unit)
     unit = _units(prog, "u_centroid", faces.centroids, unit)
     for name in ("position", "normal", "geo_normal", "glossy"):
         unit = _units(prog, f"u_{name}", [gbuffer.textures[name]], unit)

@@ -29,6 +29,7 @@ uniform sampler3D u_centroid[6]; // vct_inject: per face, xyz = its surface cent
 VCT_FETCH6(centroid_face, u_centroid)
 #if defined(MODE_ANISO)
 uniform sampler3D u_volume[6];
+uniform sampler3D u_layers;      // vct_mipmap.glsl MODE_LAYERS: rgb = τ_i · (surface coordinate along axis i)
 #else
 uniform sampler3D u_volume[1];
 #endif
@@ -42,13 +43,36 @@ const float VCT_PI = 3.14159265358979;
 // planar layer with normal along i is crossed once by a ray at any angle, so its optical depth per unit length
 // along d is |d_i|·τ_i; summed over the axes this is exact for axis-aligned layers (Crassin's d² weights would let
 // a layer leak at grazing angles). S is the τ-weighted mean of the three volumes.
-vec4 cone_step(vec3 uvw, float lod, vec3 d, float k) {
+vec4 cone_step(vec3 uvw, float lod, vec3 d, float k, vec3 start) {
 #if defined(MODE_ANISO)
     vec4 sx = d.x >= 0.0 ? textureLod(u_volume[0], uvw, lod) : textureLod(u_volume[1], uvw, lod);
     vec4 sy = d.y >= 0.0 ? textureLod(u_volume[2], uvw, lod) : textureLod(u_volume[3], uvw, lod);
     vec4 sz = d.z >= 0.0 ? textureLod(u_volume[4], uvw, lod) : textureLod(u_volume[5], uvw, lod);
     vec3 w = abs(d);
     float tau = w.x * sx.a + w.y * sy.a + w.z * sz.a;
+    if (tau <= 1e-9) return vec4(0.0);
+    // A cone meets only surfaces ahead of where it started. Filtering reads texels up to one texel behind the
+    // sample, and their radiance for this direction of travel is the side facing away from the cone: a cone
+    // passing under a sunlit roof read its lit top (measured: the courtyard's upper walls 2.2× as bright after one
+    // bounce as with the roof's top face blacked out). So axis i (its optical depth and its radiance) is skipped
+    // where the filtered surface position along i (MODE_LAYERS) lies behind both the sample and the cone's start:
+    // a surface the cone never crossed. One it crossed (between start and sample) keeps the back half of its τ
+    // hat, so it stops the cone exactly as much as before. Measured: the courtyard's upper walls 2.2× → 1.33× (the
+    // rest: the filtered position is a mean, and on coarse levels it mixes the roof with the floor); 8 bounces,
+    // Diffuse Indirect rel-L1 against 2048-spp Cycles: courtyard 0.244 → 0.178, Cornell 0.150 → 0.137, the
+    // anisotropic white furnace 94.2% → 97.6% of the exact light (a wall beside the cone's start no longer absorbs
+    // it through the filter).
+    vec4 layer = textureLod(u_layers, uvw, lod);
+    vec3 g = uvw * vec3(u_grid_size);
+    vec3 tau_axis = vec3(sx.a, sy.a, sz.a);
+    vec3 seen = vec3(1.0);
+    for (int i = 0; i < 3; ++i) {
+        if (tau_axis[i] <= 0.0) continue;
+        float c = layer[i] / tau_axis[i];
+        if ((c - g[i]) * d[i] < 0.0 && (c - start[i]) * d[i] < 0.0) seen[i] = 0.0;
+    }
+    w *= seen;
+    tau = w.x * sx.a + w.y * sy.a + w.z * sz.a;
     if (tau <= 1e-9) return vec4(0.0);
     vec3 radiance = (w.x * sx.rgb + w.y * sy.rgb + w.z * sz.rgb) / tau;
 #else
@@ -89,6 +113,7 @@ ConeResult trace_cone(vec3 p, vec3 o, vec3 n_geo, vec3 d, float tan_half) {
     bool ao_set = false;
     float t = 0.0;
     vec3 inv_size = 1.0 / vec3(u_grid_size);
+    vec3 g0 = (o - u_grid_origin) / u_cell;   // the cone's start, voxel units
     for (int i = 0; i < MAX_STEPS; ++i) {
         vec3 g = (o + d * t - u_grid_origin) / u_cell;
         if (any(lessThan(g, vec3(0.0))) || any(greaterThan(g, vec3(u_grid_size)))) {
@@ -104,7 +129,7 @@ ConeResult trace_cone(vec3 p, vec3 o, vec3 n_geo, vec3 d, float tan_half) {
         float h = h0 + t * dh;
         float cap = floor(log2(max(h / (1.5 * n1 * u_cell), 1.0)));
         lod = min(min(lod, cap), u_max_lod);
-        vec4 s = cone_step(g * inv_size, lod, d, u_step);
+        vec4 s = cone_step(g * inv_size, lod, d, u_step, g0);
         r.radiance += r.transmittance * s.rgb;
         r.transmittance *= 1.0 - s.a;
         if (r.transmittance < MIN_TRANSMITTANCE) break;

@@ -29,6 +29,13 @@
 //     direction of travel, C = C_front + (1 − α_front)·C_back, α = α_front + (1 − α_front)·α_back (premultiplied
 //     C = α·S), the columns averaged in (C, α) (see below why α and not τ), and stored back as τ = −ln(1 − α),
 //     τ·S = τ·C/α. A wall one voxel thick stays opaque at every level for rays crossing it (Crassin et al. 2011).
+// MODE_LAYERS (anisotropic only): where the surfaces of each texel lie along each axis, so that a cone can tell a
+//   surface ahead of it from one behind it (vct_common.glsl, cone_step). rgb = τ_i·p_i for axis i: p_i the
+//   τ-weighted mean coordinate (level-0 voxel units) of the texel's surfaces along i, τ_i its optical depth along
+//   i (the same for both directions of travel: front-to-back compositing of α is symmetric). Stored multiplied by
+//   τ_i so that trilinear filtering gives Σ w·τ·p, which divided by the filtered τ_i is the τ-weighted mean
+//   position of the filtered texels. Level 0 from vct_inject's face centroids (the voxel centre for a face that
+//   caught no raster sample), level l from the 8 children of level l − 1.
 // MODE_READ: copy one level of u_src[0] into a buffer (tests and statistics; moderngl reads level 0 only).
 // MODE_FLUX: per row (y, z) of the face textures, Σ_x Σ_g α_g·L_g (rgb), the occupied voxels and the faces that
 //   caught no raster sample, for the statistics of vct.face_flux (no float atomics: rows summed here and on the CPU).
@@ -71,6 +78,45 @@ void main() {
     ivec3 v = ivec3(gl_GlobalInvocationID);
     if (any(greaterThanEqual(v, u_dst_size))) return;
     texels[(v.z * u_dst_size.y + v.y) * u_dst_size.x + v.x] = texelFetch(u_src[0], v, u_level);
+}
+#elif defined(MODE_LAYERS)
+layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
+uniform sampler3D u_src[6];       // the six direction volumes, every level built
+uniform sampler3D u_centroid[6];  // level 0: vct_inject's centroids (xyz world, w = ±α_g, < 0 for a fallback face)
+uniform sampler3D u_layers_src;   // this volume, read at level u_level − 1
+uniform bool u_has_centroids;     // false: every voxel's surfaces are placed at its centre
+uniform vec3 u_grid_origin;
+uniform float u_cell;
+layout(rgba32f, binding = 0) uniform writeonly image3D u_layers_dst;
+#include "vct_arrays.glsl"
+VCT_FETCH6(src_face, u_src)
+VCT_FETCH6(centroid_face, u_centroid)
+void main() {
+    ivec3 v = ivec3(gl_GlobalInvocationID);
+    if (any(greaterThanEqual(v, u_dst_size))) return;
+    vec3 out_ = vec3(0.0);
+    for (int i = 0; i < 3; ++i) {
+        float tau = src_face(2 * i, v, u_level).a;
+        if (tau <= 0.0) continue;
+        float p = float(v[i] << u_level) + 0.5 * float(1 << u_level);   // texel centre
+        if (u_level == 0 && u_has_centroids) {
+            vec4 cp = centroid_face(2 * i, v, 0), cm = centroid_face(2 * i + 1, v, 0);
+            float sum = 0.0, n = 0.0;
+            if (cp.w > 0.0) { sum += (cp[i] - u_grid_origin[i]) / u_cell; n += 1.0; }
+            if (cm.w > 0.0) { sum += (cm[i] - u_grid_origin[i]) / u_cell; n += 1.0; }
+            if (n > 0.0) p = sum / n;
+        } else if (u_level > 0) {
+            float weighted = 0.0, taus = 0.0;
+            for (int k = 0; k < 8; ++k) {
+                ivec3 c = 2 * v + ivec3(k & 1, (k >> 1) & 1, k >> 2);
+                taus += src_face(2 * i, c, u_level - 1).a;
+                weighted += texelFetch(u_layers_src, c, u_level - 1)[i];
+            }
+            if (taus > 0.0) p = weighted / taus;
+        }
+        out_[i] = tau * p;
+    }
+    imageStore(u_layers_dst, v, vec4(out_, 0.0));
 }
 #else
 layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
