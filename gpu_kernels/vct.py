@@ -16,8 +16,9 @@ Passes (pipeline.py wires them into the pass cache):
   vct_specular  one glossy cone per pixel → Glossy Indirect (vct_specular.py).
 
 Every scale is derived; the shaders' comments give the derivations (self-occlusion bound, step opacity, anisotropic
-optical depth, the layer test), `cone_table` gives the cones'. Sky light: the world colour fills what is left of every cone that
-leaves the grid; it lands in Diffuse Indirect here, whereas Cycles counts world light as Diffuse Direct.
+optical depth, the layer test), `cone_table` gives the cones'. Sky light: the world colour fills what is left of
+every cone that leaves the grid; it lands in Diffuse Indirect here, whereas Cycles counts world light as Diffuse
+Direct.
 """
 from __future__ import annotations
 
@@ -39,11 +40,12 @@ class VctSettings:
     resolution: int = 64  # voxels along the longest axis of the scene (other axes padded, see vct_grid)
     # A cap around the normal and one ring (5..9) or two rings (13, 16, … 31), cone_table. Default 19, measured
     # (64³, defaults otherwise, 160×120, against 2048-spp 8-bounce Cycles; Diffuse Indirect / Combined rel-L1 over
-    # cone_rotation 0, 11.25, 22.5°): Cornell 0.137–0.141 / 0.070–0.072 (9 cones: 0.166–0.173 / 0.084–0.087; 13:
-    # 0.141–0.146 / 0.072–0.074), spot room 0.131–0.133 / 0.048–0.050 (9: 0.112–0.124 / 0.041–0.045; 13: 0.118–0.138
-    # / 0.044–0.050), courtyard 0.176–0.179 / 0.124–0.125 (9: 0.223–0.229 / 0.155–0.159; 13: 0.168–0.201 /
-    # 0.118–0.141). Wider cones over-weight what lies on their axis (cone_table), and fewer swing more with the
-    # cone set's turn; the per-pixel trace costs about 2.2× 9 cones', the bounce gathers (bounce_cones) are unchanged.
+    # cone_rotation 0, 11.25, 22.5°): Cornell 0.137–0.141 / 0.070–0.072 (9 cones: 0.166–0.173 /
+    # 0.084–0.087; 13: 0.141–0.146 / 0.072–0.074), spot room 0.131–0.133 / 0.048–0.050 (9: 0.112–0.124 /
+    # 0.041–0.045; 13: 0.118–0.138 / 0.044–0.050), courtyard 0.176–0.179 / 0.124–0.125 (9: 0.223–0.229 /
+    # 0.155–0.159; 13: 0.168–0.201 / 0.118–0.141). Wider cones over-weight what lies on their axis (cone_table),
+    # and fewer swing more with the cone set's turn; the per-pixel trace costs about 2.2× 9 cones', the bounce
+    # gathers (bounce_cones) are unchanged.
     diffuse_cones: int = 19
     # Cones per voxel face in the bounce gathers (vct_bounce); 0 = diffuse_cones. Bounced light is smooth, and
     # these gathers are most of a multi-bounce frame's time. Default 6, measured against 9 (64³, defaults otherwise,
