@@ -370,7 +370,8 @@ def test_cone_weights_integrate_the_cosine_exactly(count):
         dphi = 2 * math.pi / m
         w = dphi * (np.cos(mid) * np.sin(mid) * dt)[inside].sum()
         assert np.allclose(weights[first:first + m], w, rtol=1e-3), (k, weights[first:first + m], w)
-        # Mean direction of one sector φ ∈ [−Δφ/2, Δφ/2]: horizontal 2·sin(Δφ/2)·∫sin²θcosθ, vertical Δφ·∫cos²θ sinθ.
+        # Mean direction of one sector φ ∈ [−Δφ/2, Δφ/2]: horizontal 2·sin(Δφ/2)·∫sin²θcosθ,
+        # vertical Δφ·∫cos²θ sinθ.
         horizontal = (2 * math.sin(dphi / 2) if m > 1 else 0.0) * (np.sin(mid) ** 2 * np.cos(mid) * dt)[inside].sum()
         vertical = dphi * (np.cos(mid) ** 2 * np.sin(mid) * dt)[inside].sum()
         assert np.allclose(dirs[first:first + m, 2], math.cos(math.atan2(horizontal, vertical)), atol=1e-3)
