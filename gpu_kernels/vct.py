@@ -280,6 +280,13 @@ def _units(prog, name: str, textures: list, first: int) -> int:
     return first + len(textures)
 
 
+def _volume_units(prog, volumes: ConeVolumes, first: int) -> int:
+    """Bind the cone volumes (sampler array u_volume) and, anisotropic, their layer volume (u_layers) from unit
+    `first`; returns the next free unit."""
+    unit = _units(prog, "u_volume", volumes.textures, first)
+    return _units(prog, "u_layers", [volumes.layers] if volumes.layers is not None else [], unit)
+
+
 def _dispatch(prog, size, local: int = 4):
     prog.run(*((int(n) + local - 1) // local for n in size))
 

@@ -10,7 +10,7 @@ import numpy as np
 from . import direct
 from .grid import Grid
 from .vct import MAX_CONES, ConeVolumes, Faces, VctSettings, _dispatch, _grid_uniforms, _texture3d, _units, \
-    build_volumes, cone_table, face_flux
+    _volume_units, build_volumes, cone_table, face_flux
 
 
 def _cone_uniforms(prog, grid: Grid, levels: int, s: VctSettings, world) -> None:
@@ -50,8 +50,7 @@ def bounce(ctx, programs, vox, direct_faces: Faces, volumes: ConeVolumes, s: Vct
             previous = faces if b > 2 else direct_faces
             if b > 2:
                 faces = Faces([_texture3d(ctx, grid.size, zero=True) for _ in range(6)], grid, direct_faces.levels)
-        unit = _units(prog, "u_volume", source.textures, 0)
-        unit = _units(prog, "u_layers", [volumes.layers] if volumes.layers is not None else [], unit)
+        unit = _volume_units(prog, source, 0)
         unit = _units(prog, "u_direct", direct_faces.textures, unit)
         unit = _units(prog, "u_centroid", direct_faces.centroids, unit)
         _units(prog, "u_albedo", [vox.albedo], unit)
@@ -135,8 +134,7 @@ def _trace_program(programs, gbuffer, faces, volumes, s, world, rotation_deg, fi
     if fixup:
         defines["MODE_FIXUP"] = None
     prog = programs.compute("vct_trace.glsl", defines or None)
-    unit = _units(prog, "u_volume", volumes.textures, 0)
-    unit = _units(prog, "u_layers", [volumes.layers] if volumes.layers is not None else [], unit)
+    unit = _volume_units(prog, volumes, 0)
     unit = _units(prog, "u_centroid", faces.centroids, unit)
     for name in ("position", "normal", "geo_normal"):
         unit = _units(prog, f"u_{name}", [gbuffer.textures[name]], unit)

@@ -16,7 +16,7 @@ import math
 import numpy as np
 
 from . import direct
-from .vct import ConeVolumes, Faces, VctSettings, _units
+from .vct import ConeVolumes, Faces, VctSettings, _units, _volume_units
 from .vct_cones import _cone_uniforms
 
 MAX_HALF_ANGLE_DEG = 45.0  # vct_specular.glsl
@@ -36,8 +36,7 @@ def specular(ctx, programs, gbuffer, faces: Faces, volumes: ConeVolumes, s: VctS
     if not s.specular_cone:
         return {"glossy": out, "traced": 0}
     prog = programs.compute("vct_specular.glsl", {"MODE_ANISO": None} if volumes.anisotropic else None)
-    unit = _units(prog, "u_volume", volumes.textures, 0)
-    unit = _units(prog, "u_layers", [volumes.layers] if volumes.layers is not None else [], unit)
+    unit = _volume_units(prog, volumes, 0)
     unit = _units(prog, "u_centroid", faces.centroids, unit)
     for name in ("position", "normal", "geo_normal", "glossy"):
         unit = _units(prog, f"u_{name}", [gbuffer.textures[name]], unit)

@@ -66,9 +66,12 @@ void main() {
             radiance = vec3(acc(g, v, 0), acc(g, v, 1), acc(g, v, 2)) / w;
             surface = vec4(vec3(acc(g, v, 4), acc(g, v, 5), acc(g, v, 6)) / w, alpha);
         } else if (alpha > 0.0) {
+            // The centroid dispatch needs only where the face is, not its light.
+#if !defined(WRITE_CENTROIDS)
             vec3 e = vec3(0.0);
             for (int i = 0; i < u_light_count; ++i) e += light_irradiance(lights[i], surface.xyz, n, n);
             radiance = texelFetch(u_albedo, v, 0).rgb * e / PI;
+#endif
             surface.w = -alpha;
         }
 #if defined(WRITE_CENTROIDS)
