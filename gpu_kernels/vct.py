@@ -10,13 +10,14 @@ Passes (pipeline.py wires them into the pass cache):
                 surfaces behind where it started) (vct_mipmap.glsl, seed 004 §4.4);
   vct_bounce    bounces − 1 gathers at the voxel faces, each followed by a re-mip (vct_bounce.glsl);
   vct_trace     diffuse cones per G-buffer pixel (or per s × s block, indirect_scale) → Diffuse Indirect and voxel
-                AO (vct_trace.glsl, seed 004 §4.5.2);
+                AO (vct_trace.glsl, seed 004 §4.5.2); with anisotropic volumes each cone is a bundle of sub-rays
+                that meet surfaces where they cross them (vct_crossing.glsl);
   vct_upsample  reduced-resolution results back to every pixel, depth- and normal-aware (vct_upsample.py, seed 003);
   vct_accumulate  temporal average of jittered cone sets (vct_temporal.py);
   vct_specular  one glossy cone per pixel → Glossy Indirect (vct_specular.py).
 
 Every scale is derived; the shaders' comments give the derivations (self-occlusion bound, step opacity, anisotropic
-optical depth, the layer test), `cone_table` gives the cones'. Sky light: the world colour fills what is left of
+optical depth, the layer test, sub-rays), `cone_table` and `subray_radius` give the cones'. Sky light: the world colour fills what is left of
 every cone that leaves the grid; it lands in Diffuse Indirect here, whereas Cycles counts world light as Diffuse
 Direct.
 """
@@ -32,21 +33,26 @@ from .grid import Grid
 from .scene import Scene
 
 MAX_CONES = 32  # vct_common.glsl (cone_table makes at most 31)
+MAX_SUBRAYS = 7  # vct_crossing.glsl keeps them in registers (a define per count)
 CONE_FIELDS = ("diffuse_cones", "diffuse_aperture", "max_distance", "step_multiplier", "start_offset")
 
 
 @dataclass(frozen=True)
 class VctSettings:
     resolution: int = 64  # voxels along the longest axis of the scene (other axes padded, see vct_grid)
-    # A cap around the normal and one ring (5..9) or two rings (13, 16, … 31), cone_table. Default 19, measured
-    # (64³, defaults otherwise, 160×120, against 2048-spp 8-bounce Cycles; Diffuse Indirect / Combined rel-L1 over
-    # cone_rotation 0, 11.25, 22.5°): Cornell 0.137–0.141 / 0.070–0.072 (9 cones: 0.166–0.173 /
-    # 0.084–0.087; 13: 0.141–0.146 / 0.072–0.074), spot room 0.131–0.133 / 0.048–0.050 (9: 0.112–0.124 /
-    # 0.041–0.045; 13: 0.118–0.138 / 0.044–0.050), courtyard 0.176–0.179 / 0.124–0.125 (9: 0.223–0.229 /
-    # 0.155–0.159; 13: 0.168–0.201 / 0.118–0.141). Wider cones over-weight what lies on their axis (cone_table),
-    # and fewer swing more with the cone set's turn; the per-pixel trace costs about 2.2× 9 cones', the bounce
-    # gathers (bounce_cones) are unchanged.
-    diffuse_cones: int = 19
+    # A cap around the normal and one ring (5..9) or two rings (13, 16, … 31), cone_table. Default 9 with 7 sub-rays
+    # each (anisotropic volumes, vct_crossing.glsl), measured (64³, defaults otherwise, 160×120, against 2048-spp
+    # 8-bounce Cycles; Diffuse Indirect / Combined rel-L1, trace time 320×240 Cornell on llvmpipe):
+    #   9 cones × 7 sub-rays: Cornell 0.093 / 0.050, spot room 0.059 / 0.022, courtyard 0.080 / 0.059, 12 s;
+    #   9 × 5: 0.101 / 0.054, 0.062 / 0.023, 0.087 / 0.064, 7.5 s;  19 × 5: 0.080 / 0.045, 0.057 / 0.022, 0.072 /
+    #   0.053, 17 s;  19 × 7: 0.074 / 0.043, 0.058 / 0.022, 0.070 / 0.052, 25 s;  13 × 7: 0.093 / 0.051, 0.064 /
+    #   0.024, 0.077 / 0.057.
+    # (Before sub-rays, with the volumetric march: 19 cones 0.137 / 0.070, 0.131 / 0.048, 0.178 / 0.125, 2.3 s.)
+    diffuse_cones: int = 9
+    # Rays per diffuse cone in the per-pixel trace with anisotropic volumes (vct_crossing.glsl): the axis and
+    # subrays − 1 around it; each meets surfaces where it crosses them. 1 = the axis only (Cornell 0.137 / 0.072
+    # with 19 cones). The trace's cost grows about linearly with it.
+    subrays: int = 7
     # Cones per voxel face in the bounce gathers (vct_bounce); 0 = diffuse_cones. Bounced light is smooth, and
     # these gathers are most of a multi-bounce frame's time. Default 6, measured against 9 (64³, defaults otherwise,
     # Combined rel-L1 / bounce pass on llvmpipe): Cornell 0.092 vs 0.093 / 3.6 s vs 4.9 s, spot room 0.053 vs
@@ -90,6 +96,8 @@ class VctSettings:
             (16 <= self.resolution <= 512, f"resolution {self.resolution} out of range 16..512"),
             (_valid_cone_count(self.diffuse_cones), f"diffuse_cones {self.diffuse_cones} must be 5..9 or 13, 16, "
              f"19, … {MAX_CONES - 1}"),
+            (isinstance(self.subrays, int) and 1 <= self.subrays <= MAX_SUBRAYS,
+             f"subrays {self.subrays} out of range 1..{MAX_SUBRAYS}"),
             (self.bounce_cones == 0 or _valid_cone_count(self.bounce_cones),
              f"bounce_cones {self.bounce_cones} must be 0 (= diffuse_cones), 5..9 or 13, 16, 19, … {MAX_CONES - 1}"),
             (self.diffuse_aperture == 0 or 0 < self.diffuse_aperture < 90,
@@ -114,7 +122,8 @@ class VctSettings:
         """The settings a pass reads: 'bounce', 'trace' (diffuse cones per pixel, upsampling, accumulation) or
         'specular' (resolution and anisotropy key the earlier passes)."""
         extra = {"bounce": CONE_FIELDS + ("bounce_cones", "bounces", "gathered_bounces"),
-                 "trace": CONE_FIELDS + ("ao_distance", "indirect_scale", "cone_rotation", "temporal_frames"),
+                 "trace": CONE_FIELDS + ("subrays", "ao_distance", "indirect_scale", "cone_rotation",
+                                         "temporal_frames"),
                  "specular": ("max_distance", "step_multiplier", "start_offset", "specular_cone",
                               "roughness_cutoff")}[kind]
         d = asdict(self)
@@ -157,10 +166,11 @@ def cone_table(count: int, aperture_deg: float = 0.0) -> tuple[np.ndarray, np.nd
               ∫ cos²θ sinθ dθ over the ring); the second ring is turned half a sector against the first;
       aperture half-angle of a cone of the region's solid angle, acos(1 − 1/n) (27.3° for 9 cones, 18.7° for 19),
               unless given.
-    Why two rings (measured, 64³, 160×120, against 2048-spp Cycles): a cone's mip level is capped by its height
-    above the surface it starts from (vct_common.glsl), so a wide cone reads a footprint narrower than itself and
-    over-weights what lies on its axis. 9 cones of 27° gave Cornell one-bounce Diffuse Indirect rel-L1 0.23–0.27
-    (mean 1.09–1.12× of one-bounce Cycles), 19 cones of 18.7° 0.16 (1.06×) (before cone_step's layer test).
+    Why two rings are offered (measured, 64³, 160×120, against 2048-spp Cycles): in the volumetric march
+    (trace_cone, which the bounce gathers still use) a cone's mip level is capped by its height above the surface it
+    starts from, so a wide cone reads a footprint narrower than itself and over-weights what lies on its axis: 9
+    cones of 27° gave Cornell one-bounce Diffuse Indirect rel-L1 0.23–0.27, 19 cones of 18.7° 0.16. The per-pixel
+    sub-rays (vct_crossing.glsl) need no cap: 9 cones of 7 sub-rays give 0.100, 19 of 7 0.084 (VctSettings).
     """
     n = int(count)
     dirs, weights = [], []
@@ -182,6 +192,16 @@ def cone_table(count: int, aperture_deg: float = 0.0) -> tuple[np.ndarray, np.nd
         cos_a = cos_b
     half = math.radians(aperture_deg) if aperture_deg > 0 else math.acos(1.0 - 1.0 / n)
     return np.array(dirs), np.array(weights), np.full(n, math.tan(half))
+
+
+def subray_radius(count: int) -> float:
+    """Where the sub-rays around a cone's axis go (vct_crossing.glsl), in units of tan(half-angle): cut the cone's
+    disc into a central disc and a ring of count − 1 sectors, all of equal area (central radius r0 = 1/√count); a
+    sub-ray goes through the centroid of its sector's radial extent, (2/3)(1 − r0³)/(1 − r0²) — 0.736 for 7."""
+    if count <= 1:
+        return 0.0
+    r0 = 1.0 / math.sqrt(count)
+    return (2.0 / 3.0) * (1.0 - r0 ** 3) / (1.0 - r0 ** 2)
 
 
 def mip_levels(resolution: int) -> int:

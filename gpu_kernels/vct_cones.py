@@ -10,7 +10,7 @@ import numpy as np
 from . import direct
 from .grid import Grid
 from .vct import MAX_CONES, ConeVolumes, Faces, VctSettings, _dispatch, _grid_uniforms, _texture3d, _units, \
-    _volume_units, build_volumes, cone_table, face_flux
+    _volume_units, build_volumes, cone_table, face_flux, subray_radius
 
 
 def _cone_uniforms(prog, grid: Grid, levels: int, s: VctSettings, world) -> None:
@@ -130,7 +130,8 @@ def fixup(ctx, programs, gbuffer, faces: Faces, volumes: ConeVolumes, s: VctSett
 
 
 def _trace_program(programs, gbuffer, faces, volumes, s, world, rotation_deg, fixup: bool):
-    defines = {"MODE_ANISO": None} if volumes.anisotropic else {}
+    # Anisotropic volumes carry the layer volume the sub-rays need to find where surfaces lie (vct_crossing.glsl).
+    defines = {"MODE_ANISO": None, "MODE_CROSSING": None, "SUBRAYS": int(s.subrays)} if volumes.anisotropic else {}
     if fixup:
         defines["MODE_FIXUP"] = None
     prog = programs.compute("vct_trace.glsl", defines or None)
@@ -139,6 +140,12 @@ def _trace_program(programs, gbuffer, faces, volumes, s, world, rotation_deg, fi
     for name in ("position", "normal", "geo_normal"):
         unit = _units(prog, f"u_{name}", [gbuffer.textures[name]], unit)
     _cone_uniforms(prog, volumes.grid, volumes.levels, s, world)
+    if volumes.anisotropic:
+        direct._set(prog, "u_subray_radius", subray_radius(s.subrays))
+        # Sub-rays find surfaces by crossing, not by sampling them, so a step of one texel misses nothing (the three
+        # texels read around each sample cover a sub-ray's path over it); measured against half a texel: Cornell /
+        # spot room / courtyard Diffuse Indirect 0.074 / 0.058 / 0.070 vs 0.079 / 0.056 / 0.070 (19 cones).
+        direct._set(prog, "u_step", 1.0)
     phi = math.radians(s.cone_rotation if rotation_deg is None else rotation_deg)
     direct._set(prog, "u_rotation", (math.cos(phi), math.sin(phi)))
     direct._set(prog, "u_full_size", tuple(int(n) for n in gbuffer.size))

@@ -92,7 +92,9 @@ struct ConeResult {
     float ao;             // transmittance at u_ao_distance, or the sky visibility when that is 0
 };
 
-// March one cone from surface point p (geometric normal n_geo, unit) along unit d with tan(half-angle) tan_half.
+// March one cone from surface point p (geometric normal n_geo, unit) along unit d with tan(half-angle) tan_half,
+// absorbing it volumetrically: the bounce gathers at voxel faces, the specular cone, and isotropic volumes use this;
+// the per-pixel diffuse cones with anisotropic volumes are bundles of sub-rays instead (vct_crossing.glsl).
 //
 // Self-occlusion (derived, not tuned): trilinear filtering at level l reads texels whose centres lie within one
 // texel V = cell·2^l of the sample on every axis, and the texel holding p has its centre at most V/2·‖n‖₁ above p's
@@ -178,6 +180,10 @@ vec3 cone_origin(vec3 p, vec3 n_geo) {
     return o;
 }
 
+#if defined(MODE_CROSSING)
+#include "vct_crossing.glsl"
+#endif
+
 // Irradiance E at p over the hemisphere of n (rgb), and the cosine-weighted AO / sky visibility (a, in [0, 1]):
 // E = Σ_k w_k·(L_k + T_k·L_world if cone k left the grid), with Σ_k w_k = π (vct.cone_table).
 // rot = (cos φ, sin φ): the cone set turned by φ around the normal (vct_temporal.py jitters φ from frame to frame;
@@ -192,7 +198,11 @@ vec4 gather_irradiance(vec3 p, vec3 n, vec3 n_geo, vec2 rot) {
         vec4 c = u_cones[k];
         vec2 xy = vec2(rot.x * c.x - rot.y * c.y, rot.y * c.x + rot.x * c.y);
         vec3 d = normalize(t1 * xy.x + t2 * xy.y + n * c.z);
+#if defined(MODE_CROSSING)
+        ConeResult r = trace_cone_crossing(o, d, u_cone_tan[k]);
+#else
         ConeResult r = trace_cone(p, o, n_geo, d, u_cone_tan[k]);
+#endif
         e += c.w * (r.radiance + (r.exited ? r.transmittance * u_world : vec3(0.0)));
         ao += c.w * r.ao;
     }
