@@ -17,9 +17,9 @@ Passes (pipeline.py wires them into the pass cache):
   vct_specular  one glossy cone per pixel → Glossy Indirect (vct_specular.py).
 
 Every scale is derived; the shaders' comments give the derivations (self-occlusion bound, step opacity, anisotropic
-optical depth, the layer test, sub-rays), `cone_table` and `subray_radius` give the cones'. Sky light: the world colour fills what is left of
-every cone that leaves the grid; it lands in Diffuse Indirect here, whereas Cycles counts world light as Diffuse
-Direct.
+optical depth, the layer test, sub-rays), `cone_table` and `subray_radius` give the cones'. Sky light: the world
+colour fills what is left of every cone that leaves the grid; it lands in Diffuse Indirect here, whereas Cycles
+counts world light as Diffuse Direct.
 """
 from __future__ import annotations
 
@@ -50,8 +50,8 @@ class VctSettings:
     # (Before sub-rays, with the volumetric march: 19 cones 0.137 / 0.070, 0.131 / 0.048, 0.178 / 0.125, 2.3 s.)
     diffuse_cones: int = 9
     # Rays per diffuse cone in the per-pixel trace with anisotropic volumes (vct_crossing.glsl): the axis and
-    # subrays − 1 around it; each meets surfaces where it crosses them. 1 = the axis only (Cornell 0.137 / 0.072
-    # with 19 cones). The trace's cost grows about linearly with it.
+    # subrays − 1 around it; each meets surfaces where it crosses them. 1 = the axis only (9 cones: 0.202 / 0.102,
+    # 0.099 / 0.036, 0.234 / 0.163). The trace's cost grows about linearly with it.
     subrays: int = 7
     # Cones per voxel face in the bounce gathers (vct_bounce); 0 = diffuse_cones. Bounced light is smooth, and
     # these gathers are most of a multi-bounce frame's time. Default 6, measured against 9 (64³, defaults otherwise,
@@ -67,10 +67,12 @@ class VctSettings:
     # Gather only this many bounces and extrapolate the rest up to `bounces` as a geometric series of the last
     # increment (vct_cones._extrapolate_tail); 0 = gather every bounce. Each gathered bounce is a full cone pass
     # over the voxels, the tail a few array operations. Default 4, measured against gathering all 8 (Combined
-    # rel-L1, 64³, 9 cones everywhere): Cornell 0.093 vs 0.092, spot room 0.058 vs 0.056, courtyard 0.181 vs 0.180 in half the
-    # time (Cornell bounce pass 4.8 s vs 11.0 s on llvmpipe); gathering 3 was 0.098 / 0.057 / 0.198.
+    # rel-L1, 64³, 9 cones everywhere): Cornell 0.093 vs 0.092, spot room 0.058 vs 0.056, courtyard 0.181 vs 0.180
+    # in half the time (Cornell bounce pass 4.8 s vs 11.0 s on llvmpipe); gathering 3 was 0.098 / 0.057 / 0.198.
     gathered_bounces: int = 4
-    step_multiplier: float = 0.5  # step / sampled voxel size (seed 004 listing 4.1 steps by the cone radius)
+    # Step / sampled voxel size of the volumetric march (seed 004 listing 4.1 steps by the cone radius): the bounce
+    # gathers, the specular cone, isotropic volumes. The per-pixel sub-rays step one texel (vct_cones._trace_program).
+    step_multiplier: float = 0.5
     start_offset: float = 1.5  # voxels along the normal (× ‖n‖₁): the trilinear support of the own texel
     # One glossy cone per pixel along the reflected view direction → Glossy Indirect (vct_specular.py); pixels
     # with no glossy closure or rougher than roughness_cutoff run no cone, so scenes without glossy materials pay

@@ -205,9 +205,9 @@ def test_a_lit_patch_in_a_dark_floor_matches_its_view_factor(engine, receiver):
     """A 3 × 2.5 m lit patch in a black 6 × 6 m floor, seen from a plate 3 m above it and from a wall 1.5 m beside
     it (the courtyard's case: bounced light from a sunlit patch). Before the per-pixel sub-rays (vct_crossing.glsl)
     the cones read the patch at their own coarse level, which spread its light over neighbouring cones, and skimmed
-    the floor without meeting it: the plate came out 1.61× and the wall 1.51× the exact integral (64³, 19 cones). Measured
-    since: plate 0.963 (per-sample rel-L1 0.059), wall 1.008 (0.083). Bounds: mean within 10%, rel-L1 below 0.15 —
-    the quadrature of 9 cones × 7 sub-rays and the voxel's size (6.4 cm) at the patch's edges."""
+    the floor without meeting it: the plate came out 1.61× and the wall 1.51× the exact integral (64³, 19 cones).
+    Measured since: plate 0.963 (per-sample rel-L1 0.059), wall 1.008 (0.083). Bounds: mean within 10%, rel-L1
+    below 0.15 — the quadrature of 9 cones × 7 sub-rays and the voxel's size (6.4 cm) at the patch's edges."""
     patch = (-1.5, 1.5, -1.25, 1.25)
     x0, x1, y0, y1 = patch
 

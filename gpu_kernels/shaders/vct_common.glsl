@@ -154,11 +154,11 @@ void onb(vec3 n, out vec3 t1, out vec3 t2) {
 // holds another surface. A point within a voxel of a wall it stands beside (a floor pixel at an edge, a corner)
 // would otherwise start inside that wall's voxel, and a ray leaving it away from the wall would meet the voxel's
 // far face — the wall's back — as if it still had to cross the wall (the white furnace lost up to 40% of its light
-// next to the box's edges). So for each axis, the voxel holding o and its two neighbours along it are checked for a surface
-// across that axis lying between p's side and o (its position: the centroid of its faces, vct_inject.glsl), and o
-// moves along the axis, to p's side, to at least the centre of the voxel next to it: there the trilinear support
-// of the first sample no longer reaches the wall's voxel. Measured (anisotropic white furnace, 32³): 92.7% → 94.8% of
-// the exact value overall, 60% → 87% within 2 cm of the box's edges.
+// next to the box's edges). So for each axis, the voxel holding o and its two neighbours along it are checked for a
+// surface across that axis lying between p's side and o (its position: the centroid of its faces, vct_inject.glsl),
+// and o moves along the axis, to p's side, to at least the centre of the voxel next to it: there the trilinear
+// support of the first sample no longer reaches the wall's voxel. Measured (anisotropic white furnace, 32³): 92.7% →
+// 94.8% of the exact value overall, 60% → 87% within 2 cm of the box's edges.
 vec3 cone_origin(vec3 p, vec3 n_geo) {
     float n1 = abs(n_geo.x) + abs(n_geo.y) + abs(n_geo.z);
     vec3 o = p + n_geo * (u_offset * n1 * u_cell);
