@@ -71,7 +71,7 @@ class VctSettings:
     # in half the time (Cornell bounce pass 4.8 s vs 11.0 s on llvmpipe); gathering 3 was 0.098 / 0.057 / 0.198.
     gathered_bounces: int = 4
     # Step / sampled voxel size of the volumetric march (seed 004 listing 4.1 steps by the cone radius): the bounce
-    # gathers, the specular cone, isotropic volumes. The per-pixel sub-rays step one texel (vct_cones._trace_program).
+    # gathers, the specular cone, isotropic volumes. The per-pixel sub-rays step one texel (vct_crossing.glsl).
     step_multiplier: float = 0.5
     start_offset: float = 1.5  # voxels along the normal (× ‖n‖₁): the trilinear support of the own texel
     # One glossy cone per pixel along the reflected view direction → Glossy Indirect (vct_specular.py); pixels

@@ -29,6 +29,10 @@
 #define SUBRAYS 7                 // the axis and SUBRAYS − 1 rays around it (a define: loops of constant length
 #endif                            // keep the per-sub-ray arrays in registers)
 uniform float u_subray_radius;    // their distance from the axis, in units of tan(half-angle)
+// Sub-rays find surfaces by crossing, not by sampling them, so a step of one texel misses nothing that the three
+// texels read around each sample cover (see `limit` below); measured against half a texel (19 cones): Cornell / spot
+// room / courtyard Diffuse Indirect 0.074 / 0.058 / 0.070 vs 0.079 / 0.056 / 0.070, at 1.6× the time for the latter.
+#define STEP_TEXELS 1.0
 
 ConeResult trace_cone_crossing(vec3 o, vec3 d, float tan_half) {
     float ao_limit = u_ao_distance > 0.0 ? u_ao_distance : 3.4e38;
@@ -55,7 +59,7 @@ ConeResult trace_cone_crossing(vec3 o, vec3 d, float tan_half) {
         if (u_max_distance > 0.0 && seg_start * u_cell > u_max_distance) break;
         float lod = min(floor(log2(max(2.0 * t * tan_half, 1.0))), u_max_lod);
         float texel = exp2(lod);
-        float seg_end = t + 0.5 * u_step * texel;
+        float seg_end = t + 0.5 * STEP_TEXELS * texel;
         // The three texels read along each axis reach at least one texel either side of the sample. A sub-ray lies
         // ≤ 0.74·tan·t < 0.74 texel off the axis (texel > t·tan below the coarsest level; clamped to 1.2 texels
         // beyond it) and a step moves it ≤ 0.5 texel, so only a crossing in the outermost quarter texel of its reach
@@ -87,6 +91,7 @@ ConeResult trace_cone_crossing(vec3 o, vec3 d, float tan_half) {
         // Per axis a, the texels mid − 1 … mid + 1 along a (mid holds the sample) that some sub-ray's path reaches,
         // and where along a their surfaces lie.
         float where[9];   // voxel units; −1: no surface (surfaces lie at ≥ 1: the grid has an empty margin voxel)
+        bool any_surface = false;
         for (int a = 0; a < 3; ++a) {
             float mid = floor(g[a] / texel);
             for (int k = 0; k < 3; ++k) {
@@ -102,19 +107,16 @@ ConeResult trace_cone_crossing(vec3 o, vec3 d, float tan_half) {
                 if (layer <= 0.0) continue;
                 // τ_a is the same in the volumes for both directions along a (vct_mipmap.glsl MODE_LAYERS).
                 float tau = textureLod(u_volume[2 * a], q, lod).a;
-                if (tau > 0.0) where[n] = layer / tau;
+                if (tau > 0.0) {
+                    where[n] = layer / tau;
+                    any_surface = true;
+                }
             }
-        }
-        if (all(lessThan(vec3(where[0], where[1], where[2]), vec3(0.0))) &&
-            all(lessThan(vec3(where[3], where[4], where[5]), vec3(0.0))) &&
-            all(lessThan(vec3(where[6], where[7], where[8]), vec3(0.0)))) {   // nothing to cross: empty space
-            seg_start = seg_end;
-            t += u_step * texel;
-            continue;
         }
         float hit_lod = max(lod - 1.0, 0.0);
         float hit_texel = exp2(hit_lod);
-        for (int j = 0; j < ns; ++j) {
+        for (int j = 0; j < ns && any_surface; ++j) {   // in empty space there is nothing to cross
+
             if (T[j] < MIN_TRANSMITTANCE) continue;
             vec3 m = gb[j] - ga[j];
             for (int a = 0; a < 3; ++a) {
@@ -139,7 +141,7 @@ ConeResult trace_cone_crossing(vec3 o, vec3 d, float tan_half) {
             }
         }
         seg_start = seg_end;
-        t += u_step * texel;
+        t += STEP_TEXELS * texel;
     }
     float left = 0.0;
     for (int j = 0; j < ns; ++j) left += max(T[j], 0.0);
