@@ -9,7 +9,10 @@ absorbed light → irradiance. Every scale is derived, none tuned (see the shade
 - lookup (default "flux"): a surface's irradiance is the flux fuzzy occlusion stopped at it, per area — summed
   over all surfaces this is exactly the injected flux that did not leave the grid (lpv_occlusion.py); the
   classic lookup, SH intensity convolved with the cosine / cell², is `lookup="intensity"`;
-- bounces: absorbed light × albedo is injected again.
+- bounces: absorbed light × albedo is injected again;
+- transport (default "gather", lpv_gather.py): every surface voxel gathers the VPLs' light directly, bounce by
+  bounce, with fuzzy visibility — the face scheme turns light sideways within a few cells; "propagate" is the
+  classic LPV above. World light propagates either way.
 
 Iterations stop adaptively once a step moves less than `epsilon` of the injected flux.
 """
@@ -23,7 +26,8 @@ import numpy as np
 from . import direct
 from . import light_buffers as lb
 from .grid import Grid
-from .lpv_occlusion import GeometryVolume, absorb, geometry_volumes, inject_bounce  # noqa: F401 (pipeline uses lpv.*)
+from .lpv_gather import bounce_vpls, extrapolate_tail, gather, rsm_uniforms, vpl_list
+from .lpv_occlusion import GeometryVolume, absorb, geometry_volumes, inject_bounce  # noqa: F401 (pipeline: lpv.*)
 from .lpv_state import (FIXED_RANGE, SH_FLUX, LpvGridState, LpvSettings, Volumes, _grid_uniforms,  # noqa: F401
                         _volumes, copy_volumes, resolve, transfer_matrices)
 from .scene import Scene
@@ -135,31 +139,20 @@ def sky_flux_bound(grid: Grid, world_color) -> float:
 
 
 def inject(ctx, programs, rsm: Rsm, shadows, state: LpvGridState, world_color=(0.0, 0.0, 0.0),
-           gv=None, downsample: int = 1) -> float:
-    """RSM texels (and world light at the open border) → fixed-point SH sums → state.injected. Returns the
-    injected flux (W, sum of RGB)."""
+           gv=None, downsample: int = 1, vpls: bool = True) -> float:
+    """RSM texels (unless not `vpls`) and world light at the open border → fixed-point SH sums → state.injected.
+    Returns the injected flux (W, sum of RGB)."""
     grid = state.grid
     sky = max(world_color[:3]) > 0
     scale = FIXED_RANGE / (rsm.flux_bound + (sky_flux_bound(grid, world_color) if sky else 0.0))
     state.accum_ints.clear()
-    prog = programs.compute("lpv_inject.glsl")
-    for unit, tex in enumerate((rsm.position, rsm.normal, rsm.albedo)):
-        tex.use(location=unit)
-    direct._set(prog, "u_rsm_position", 0)
-    direct._set(prog, "u_rsm_normal", 1)
-    direct._set(prog, "u_rsm_albedo", 2)
-    direct._set(prog, "u_rsm_size", rsm.size)
-    direct._set(prog, "u_rsm_resolution", int(rsm.resolution))
-    direct._set(prog, "u_downsample", int(downsample))
-    direct._set(prog, "u_fixed_scale", float(scale))
-    _grid_uniforms(prog, grid)
-    shadows.light_ssbo.bind_to_storage_buffer(0)
-    shadows.view_ssbo.bind_to_storage_buffer(1)
-    shadows.polygon_ssbo.bind_to_storage_buffer(2)
-    rsm.views_ssbo.bind_to_storage_buffer(3)
-    state.accum_ints.bind_to_storage_buffer(4)
-    blocks = ((rsm.size[0] + downsample - 1) // downsample, (rsm.size[1] + downsample - 1) // downsample)
-    prog.run((blocks[0] + 7) // 8, (blocks[1] + 7) // 8, 1)
+    if vpls:
+        prog = programs.compute("lpv_inject.glsl")
+        blocks = rsm_uniforms(prog, rsm, shadows, downsample)
+        direct._set(prog, "u_fixed_scale", float(scale))
+        _grid_uniforms(prog, grid)
+        state.accum_ints.bind_to_storage_buffer(4)
+        prog.run((blocks[0] + 7) // 8, (blocks[1] + 7) // 8, 1)
     if sky:
         sky_prog = programs.compute("lpv_sky.glsl")
         _grid_uniforms(sky_prog, grid)
@@ -225,15 +218,19 @@ def propagate(ctx, programs, state: LpvGridState, source: Volumes, injected_flux
 
 
 def inject_all(ctx, programs, rsm: Rsm, shadows, grids: list, world_color=(0.0, 0.0, 0.0),
-               gvs=None, downsample: int = 1) -> list:
+               gvs=None, downsample: int = 1, gather_vpls: int = 0) -> list:
     """Inject the RSM VPLs and the world light into a fresh state per cascade (finest first). World light enters
     each cascade through its open border: exact for the coarsest grid, whose border is the scene's; a finer
-    cascade assumes the world is visible beyond its border (true outdoors, too bright inside closed rooms)."""
+    cascade assumes the world is visible beyond its border (true outdoors, too bright inside closed rooms).
+    With `gather_vpls` > 0 the VPLs are listed for the gathered first bounce (state.vpls) instead of injected."""
     states = []
     for i, grid in enumerate(grids):
         state = LpvGridState(ctx, grid)
         gv = gvs[i] if gvs else None
-        state.injected_flux = inject(ctx, programs, rsm, shadows, state, world_color, gv, downsample)
+        state.injected_flux = inject(ctx, programs, rsm, shadows, state, world_color, gv, downsample,
+                                     vpls=not gather_vpls)
+        if gather_vpls:
+            state.vpls = vpl_list(ctx, programs, rsm, shadows, grid, gather_vpls)
         states.append(state)
     return states
 
@@ -266,6 +263,45 @@ def propagate_all(ctx, programs, states: list, gvs: list, settings: LpvSettings)
         stats.append({"cells": list(state.grid.size), "cell": state.grid.cell,
                       "injected_flux": state.injected_flux, "bounces": bounces,
                       "iterations": sum(b["iterations"] for b in bounces)})
+    return {"cascades": stats}
+
+
+def gather_all(ctx, programs, states: list, gvs: list, settings: LpvSettings) -> dict:
+    """The gathered transport (lpv_gather.py), per cascade: world light propagates and is absorbed as in
+    `propagate_all`; the RSM's VPLs (state.vpls) and then, bounce by bounce, the light the surface voxels reflect
+    are gathered straight to the surface voxels."""
+    stats = []
+    for state, gv in zip(states, gvs):
+        state.face_flux.clear()
+        iterations = 0
+        if state.injected_flux > 0:  # world light: the only light injected for this transport
+            iterations = propagate(ctx, programs, state, state.injected, state.injected_flux, gv.blocking, settings,
+                                   accumulate=False)["iterations"]
+        absorb(ctx, programs, state, gv, add=False)  # the world light's irradiance (zeros without it)
+        bounces = []
+        gathered = min(settings.bounces, settings.gathered_bounces or settings.bounces)
+        vpls = state.vpls
+        for bounce in range(gathered):
+            gather(ctx, programs, state, gv, vpls, settings.occlusion, fresh=bounce > 0)
+            bounces.append({"vpls": vpls.count, "flux": vpls.flux, "block": vpls.block})
+            if bounce > 0:
+                vpls.release()
+            if vpls.count == 0 or bounce + 1 == settings.bounces:
+                break
+            previous = vpls.flux_rgb
+            vpls = bounce_vpls(ctx, programs, state, gv, settings.gather_vpls)
+            if bounce + 1 == gathered:  # bounces gathered + 1 … N: extrapolated from the flux ratio
+                vpls.release()
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    ratio = np.nan_to_num(np.asarray(vpls.flux_rgb) / np.asarray(previous))
+                ratio = np.clip(ratio, 0.0, 0.99)  # < 1: a passive scene cannot gain light per bounce
+                n = settings.bounces - gathered
+                tail = ratio * (1.0 - ratio ** n) / (1.0 - ratio)
+                extrapolate_tail(ctx, programs, state, gv, tail)
+                bounces.append({"extrapolated": n, "ratio": [float(r) for r in ratio]})
+        stats.append({"cells": list(state.grid.size), "cell": state.grid.cell,
+                      "injected_flux": state.injected_flux + state.vpls.flux, "world_flux": state.injected_flux,
+                      "bounces": bounces, "iterations": iterations})
     return {"cascades": stats}
 
 

@@ -21,10 +21,13 @@ class GeometryVolume:
     area: object  # fine voxel textures from voxelize(): projected areas per axis + total area
     normal: object
     albedo: object
+    coverage: object = None  # per LPV cell (crossing_layers): its surfaces' plane(s) and covered fraction
+    layers: object = None  # per LPV cell: where those planes lie (cells from the grid origin)
 
     def release(self):
-        for t in (self.blocking, self.area, self.normal, self.albedo):
-            t.release()
+        for t in (self.blocking, self.area, self.normal, self.albedo, self.coverage, self.layers):
+            if t is not None:
+                t.release()
 
 
 def face_blocking(area: np.ndarray, grid: Grid) -> np.ndarray:
@@ -51,6 +54,54 @@ def face_blocking(area: np.ndarray, grid: Grid) -> np.ndarray:
     return out.astype(np.float32)
 
 
+PLANAR = 0.9  # a cell whose surfaces' normals share one plane this closely (λ_max / trace) is one oblique plane
+
+
+def crossing_layers(area: np.ndarray, normal: np.ndarray, grid: Grid) -> tuple[np.ndarray, np.ndarray]:
+    """Where each LPV cell's surfaces lie, for the gathered transport's visibility (lpv_gather.glsl): a ray that
+    crosses them inside the cell is stopped by the fraction of the cell they cover.
+
+    A cell whose surfaces are one plane (the area-weighted normal tensor Σ A·n·nᵀ has one dominant direction,
+    λ_max / trace ≥ PLANAR: a wall, a floor, a patch of a sphere) is that plane — normal n (the principal axis,
+    sign-free), offset n·x over its voxels' centres, coverage min(1, area / cell²). Otherwise (an edge or corner
+    where a floor meets a wall) it is three axis planes, one per axis a: coverage min(1, projected area / cell²)
+    at the projected-area-weighted mean coordinate. Axis planes alone would turn a sphere into a staircase that
+    rays leaving it at a grazing angle cross; one mean plane alone would put a diagonal wall across every corner.
+
+    Returns (nz, ny, nx, 4) arrays `coverage` and `layers`, in cells from the grid origin: for a plane cell
+    coverage = (n, −coverage), layers = (0, 0, 0, offset); for an axis cell coverage = (c_x, c_y, c_z, 0),
+    layers = (x̄, ȳ, z̄, 0); empty cells are zero. LPV cell c holds fine voxels [2c + 1, 2c + 3) along each axis
+    (fine voxel f's centre: (f + 0.5)/2 − 1/2 cells)."""
+    nx, ny, nz = grid.size
+    inner = (slice(1, 2 * nz + 1), slice(1, 2 * ny + 1), slice(1, 2 * nx + 1))
+    proj = area[inner][..., :3].astype(np.float64)
+    total = area[inner][..., 3].astype(np.float64)
+    n = normal[inner][..., :3].astype(np.float64)
+    n /= np.maximum(np.linalg.norm(n, axis=-1, keepdims=True), 1e-30)
+    zz, yy, xx = np.meshgrid(*[(np.arange(1, 2 * k + 1) + 0.5) / 2 - 0.5 for k in (nz, ny, nx)], indexing="ij")
+    centre = np.stack([xx, yy, zz], axis=-1)  # per fine voxel: (x, y, z) in cells
+
+    def per_cell(values):
+        return values.reshape(nz, 2, ny, 2, nx, 2, *values.shape[3:]).sum(axis=(1, 3, 5))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        proj_cell = per_cell(proj)
+        axis_layer = np.nan_to_num(per_cell(proj * centre) / proj_cell)
+        area_cell = per_cell(total)
+        tensor = per_cell(total[..., None, None] * n[..., :, None] * n[..., None, :])
+        eigval, eigvec = np.linalg.eigh(tensor)  # ascending
+        planar = (area_cell > 0) & (eigval[..., 2] >= PLANAR * np.maximum(eigval.sum(axis=-1), 1e-30))
+        plane_n = eigvec[..., :, 2]
+        offset = np.nan_to_num(np.einsum("zyxi,zyxi->zyx", per_cell(total[..., None] * centre), plane_n) / area_cell)
+    coverage = np.zeros((nz, ny, nx, 4), np.float32)
+    layers = np.zeros((nz, ny, nx, 4), np.float32)
+    coverage[..., :3] = np.minimum(proj_cell / grid.cell ** 2, 1.0)
+    layers[..., :3] = axis_layer
+    cov = np.minimum(area_cell / grid.cell ** 2, 1.0)
+    coverage[planar] = np.concatenate([plane_n[planar], -cov[planar][:, None]], axis=1)
+    layers[planar] = np.concatenate([np.zeros((planar.sum(), 3)), offset[planar][:, None]], axis=1)
+    return coverage, layers
+
+
 def geometry_volumes(ctx, programs, scene: Scene, geometry, textures, grids: list) -> list:
     """Fuzzy-occlusion volumes, one per cascade, from a voxelisation of the whole scene (view-independent).
 
@@ -67,12 +118,17 @@ def geometry_volumes(ctx, programs, scene: Scene, geometry, textures, grids: lis
     for grid in grids:
         fine = Grid(tuple(np.asarray(grid.origin) - grid.cell / 2), grid.cell / 2, tuple(2 * n + 2 for n in grid.size))
         vox = voxelize(ctx, programs, scene, geometry, textures, fine)
-        blocking = face_blocking(vox.read()["area"], grid)
+        area = vox.read()["area"]
+        blocking = face_blocking(area, grid)
         tex = ctx.texture3d(tuple(n + 1 for n in grid.size), 4, np.ascontiguousarray(blocking).tobytes(), dtype="f4")
         for t in (tex, vox.area, vox.normal, vox.albedo):
             t.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        crossings = [ctx.texture3d(tuple(grid.size), 4, a.tobytes(), dtype="f4")
+                     for a in crossing_layers(area, vox.read()["normal"], grid)]
+        for t in crossings:
+            t.filter = (moderngl.NEAREST, moderngl.NEAREST)
         vox.emission.release()
-        out.append(GeometryVolume(tex, fine, vox.area, vox.normal, vox.albedo))
+        out.append(GeometryVolume(tex, fine, vox.area, vox.normal, vox.albedo, *crossings))
     return out
 
 

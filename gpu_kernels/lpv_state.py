@@ -33,13 +33,23 @@ class LpvSettings:
     clamp_negative: bool = False
     damping: bool = False  # seed 000's directional-derivative damping at lookup
     blend_cells: float = 2.0  # cascade border blend width (cells)
-    bounces: int = 3  # indirect bounces (1 = light reflected once); bounces > 1 need occlusion
+    bounces: int = 8  # indirect bounces (1 = light reflected once; Cycles' default 8); > 1 need occlusion
+    # Gathered transport: gather this many bounces, extrapolate the rest to `bounces` as a geometric series of the
+    # last pass (lpv_tail.glsl); 0 = gather every bounce. The propagating transport propagates every bounce.
+    gathered_bounces: int = 3
     lookup: str = "flux"  # "flux": absorbed face flux per area (conserves energy); "intensity": Kaplanyan's I/cell²
     # Octree LPV (seed 002, lpv_octree.py): 0 = uniform grid; L ≥ 1 = full octree O_0..O_{L-1} (O_0 = this grid,
     # O_i = n/2^i), index volume, per-level propagation, merge (L = 1: the octree path with one level, which equals
     # the uniform grid with `octree_iterations` steps, one bounce, intensity lookup).
     octree_levels: int = 0
     octree_iterations: int = 4  # propagation steps on every octree level (seed 002 §4: k = 4)
+    # Transport: "gather" sends light straight from VPLs to every surface voxel with fuzzy visibility, bounce by
+    # bounce (lpv_gather.py: the face scheme turns light sideways within a few cells); "propagate" is the classic
+    # LPV. World light propagates either way. The gather writes surface voxels' irradiance, which only the flux
+    # lookup with occlusion reads: the intensity lookup, occlusion=False and the octree always propagate (see
+    # `gathers`). `gather_vpls` bounds the VPLs per bounce: RSM texels and surface voxels are clustered to fit.
+    transport: str = "gather"
+    gather_vpls: int = 512
 
     def __post_init__(self):
         if not 4 <= self.resolution <= 256:
@@ -48,6 +58,12 @@ class LpvSettings:
             raise ValueError(f"cascades {self.cascades} out of range 1..4")
         if self.lookup not in ("flux", "intensity"):
             raise ValueError(f"lookup must be 'flux' or 'intensity', not {self.lookup!r}")
+        if self.transport not in ("gather", "propagate"):
+            raise ValueError(f"transport must be 'gather' or 'propagate', not {self.transport!r}")
+        if self.gathered_bounces < 0:
+            raise ValueError(f"gathered_bounces {self.gathered_bounces} must be ≥ 0 (0: gather every bounce)")
+        if not 16 <= self.gather_vpls <= 65536:
+            raise ValueError(f"gather_vpls {self.gather_vpls} out of range 16..65536")
         if self.rsm_downsample not in (1, 2, 4):
             raise ValueError(f"rsm_downsample must be 1, 2 or 4, not {self.rsm_downsample}")
         if self.bounces < 1 or self.max_iterations < 1 or self.rsm_resolution < 8:
@@ -58,6 +74,12 @@ class LpvSettings:
                                    or 2 ** (self.octree_levels - 1) > self.resolution):
             raise ValueError("the octree LPV needs cascades=1, occlusion (its index volume comes from the geometry "
                              "volume) and 2^(octree_levels-1) ≤ resolution")
+
+    @property
+    def gathers(self) -> bool:
+        """Whether light is gathered (transport="gather" where the flux lookup reads it)."""
+        return (self.transport == "gather" and self.lookup == "flux" and self.occlusion
+                and not self.octree_levels)
 
 
 def sh_basis(d) -> np.ndarray:
@@ -138,11 +160,12 @@ class LpvGridState:
         self.face_flux = ctx.buffer(reserve=n * 6 * 16)  # vec4 per cell and direction of travel
         self.front = self.back = None  # absorbed-light irradiance per fine voxel, last pass (set by `absorb`)
         self.front_total = self.back_total = None  # summed over bounces
+        self.vpls = None  # the RSM's VPLs for the gathered transport (lpv_gather.vpl_list)
 
     def release(self):
         for obj in (self.accum_ints, self.injected, self.accum, self.ping, self.pong, self.injected_next,
                     self.counter, self.face_flux,
-                    self.front, self.back, self.front_total, self.back_total):
+                    self.front, self.back, self.front_total, self.back_total, self.vpls):
             if obj is not None:
                 obj.release()
 

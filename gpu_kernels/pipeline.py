@@ -142,9 +142,10 @@ class Pipeline:
         k_gv = (k_geometry, k_materials, k_grids, s.occlusion)
         gvs = cache.run("geometry_volume", k_gv, lambda: lpv.geometry_volumes(
             ctx, programs, scene, geometry, textures, grids) if s.occlusion else [None] * len(grids))
-        k_inject = (k_rsm, k_grids, k_gv, _hash(scene.world), s.rsm_downsample)
-        states = cache.run("lpv_inject", k_inject, lambda: lpv.inject_all(ctx, programs, rsm, shadows, grids,
-                                                                          scene.world.color, gvs, s.rsm_downsample))
+        gather_vpls = s.gather_vpls if s.gathers else 0
+        k_inject = (k_rsm, k_grids, k_gv, _hash(scene.world), s.rsm_downsample, gather_vpls)
+        states = cache.run("lpv_inject", k_inject, lambda: lpv.inject_all(
+            ctx, programs, rsm, shadows, grids, scene.world.color, gvs, s.rsm_downsample, gather_vpls))
         k_prop = (k_inject, k_gv, repr(s))
         if s.octree_levels:  # seed 002 (lpv_octree.py): index volume, downsample, per-level propagation, merge
             from . import lpv_octree as lo
@@ -156,7 +157,8 @@ class Pipeline:
             merged = cache.run("lpv_merge", k_prop, lambda: lo.merge(ctx, programs, tree, geo))
             states, gvs, s = [merged], [None], lo.lookup_settings(s)
         else:
-            stats = cache.run("lpv_propagate", k_prop, lambda: lpv.propagate_all(ctx, programs, states, gvs, s))
+            transport = lpv.gather_all if s.gathers else lpv.propagate_all
+            stats = cache.run("lpv_propagate", k_prop, lambda: transport(ctx, programs, states, gvs, s))
         k_light = (k_gbuffer, k_prop)
         indirect = cache.run("lpv_lighting", k_light, lambda: lpv.lighting(ctx, programs, gbuffer, states, gvs, s))
         return indirect, k_light, stats

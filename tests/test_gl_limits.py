@@ -16,7 +16,7 @@ from bounce_gi.gpu_kernels.lpv import LpvSettings
 from bounce_gi.gpu_kernels.pipeline import RenderSettings
 from bounce_gi.gpu_kernels.scene import Light, Material
 from bounce_gi.gpu_kernels.vct import VctSettings
-from test_vct import _quad, _scene
+from support.synthetic import quad, quad_scene
 
 MAX_IMAGES = 8
 MAX_SAMPLERS = 32
@@ -48,12 +48,12 @@ def _room():
                                                                [0, 0, 0, 1.0]]))
     area = Light("area", "AREA", (1, 1, 1), 50.0, np.array([[1, 0, 0, -1], [0, 1, 0, 0], [0, 0, 1, 1.9],
                                                                [0, 0, 0, 1.0]]))
-    floor = _quad([(-2, -2, 0), (2, -2, 0), (2, 1, 0), (-2, 1, 0)], (0, 0, 1))
-    wall = _quad([(-2, 1, 0), (2, 1, 0), (2, 1, 2), (-2, 1, 2)], (0, -1, 0))
-    lamp = _quad([(1.5, 0.5, 0.2), (1.9, 0.5, 0.2), (1.9, 0.9, 0.2), (1.5, 0.9, 0.2)], (0, 0, 1))
+    floor = quad([(-2, -2, 0), (2, -2, 0), (2, 1, 0), (-2, 1, 0)], (0, 0, 1))
+    wall = quad([(-2, 1, 0), (2, 1, 0), (2, 1, 2), (-2, 1, 2)], (0, -1, 0))
+    lamp = quad([(1.5, 0.5, 0.2), (1.9, 0.5, 0.2), (1.9, 0.9, 0.2), (1.5, 0.9, 0.2)], (0, 0, 1))
     materials = [Material("floor", (0.5, 0.5, 0.5), roughness=0.1, specular_layer=True), Material("wall"),
                  Material("lamp", (0, 0, 0), emission=(4.0, 4.0, 4.0))]
-    return _scene([(floor, 0), (wall, 1), (lamp, 2)], materials, [sun, point, spot, area], (0, -4, 1.2),
+    return quad_scene([(floor, 0), (wall, 1), (lamp, 2)], materials, [sun, point, spot, area], (0, -4, 1.2),
                   (0, 0.5, 0.2), world=(0.1, 0.1, 0.1), lens=20.0)
 
 

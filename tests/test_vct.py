@@ -20,54 +20,14 @@ from bounce_gi.gpu_kernels import camera as cam
 from bounce_gi.gpu_kernels import vct
 from bounce_gi.gpu_kernels.engine import Engine
 from bounce_gi.gpu_kernels.pipeline import RenderSettings
-from bounce_gi.gpu_kernels.scene import Camera, Light, Material, Scene, World
+from bounce_gi.gpu_kernels.scene import Light, Material
 from bounce_gi.gpu_kernels.vct import VctSettings
+from support.synthetic import box_quads, patch_view_factor, quad, quad_scene
 
 
 @pytest.fixture(scope="module")
 def engine():
     return Engine()
-
-
-def _quad(corners, normal):
-    """Two triangles of the quad, wound so their geometric normal is `normal`."""
-    c = np.asarray(corners, np.float64)
-    tris = np.array([[c[0], c[1], c[2]], [c[0], c[2], c[3]]])
-    for t in range(2):
-        if np.cross(tris[t, 1] - tris[t, 0], tris[t, 2] - tris[t, 0]) @ np.asarray(normal, float) < 0:
-            tris[t] = tris[t][::-1]
-    return tris
-
-
-def _scene(quads, materials, lights, eye, target, world=(0.0, 0.0, 0.0), lens=16.0):
-    """quads: [(triangles (2, 3, 3), material index)]."""
-    pos = np.concatenate([q for q, _ in quads]).astype(np.float32)
-    n = np.cross(pos[:, 1] - pos[:, 0], pos[:, 2] - pos[:, 0])
-    n /= np.linalg.norm(n, axis=1, keepdims=True)
-    mats = np.concatenate([np.full(len(q), m, np.int32) for q, m in quads])
-    c2w = np.linalg.inv(cam.look_at(eye, target, (0, 0, 1)))
-    return Scene(pos, np.repeat(n[:, None], 3, axis=1).astype(np.float32), np.zeros((len(pos), 3, 2), np.float32),
-                 mats, materials, [], lights, World(world), Camera(c2w, lens=lens))
-
-
-def _box_quads(lo, hi, material, inward=True, skip=()):
-    """The six faces of an axis-aligned box, normals pointing in (or out)."""
-    lo, hi = np.asarray(lo, float), np.asarray(hi, float)
-    out = []
-    for axis in range(3):
-        for side, value in (("lo", lo[axis]), ("hi", hi[axis])):
-            if (axis, side) in skip:
-                continue
-            u, w = (axis + 1) % 3, (axis + 2) % 3
-            corners = []
-            for a, b in ((0, 0), (1, 0), (1, 1), (0, 1)):
-                p = np.zeros(3)
-                p[axis], p[u], p[w] = value, (lo[u], hi[u])[a], (lo[w], hi[w])[b]
-                corners.append(p)
-            normal = np.zeros(3)
-            normal[axis] = (1.0 if side == "lo" else -1.0) * (1.0 if inward else -1.0)
-            out.append((_quad(corners, normal), material))
-    return out
 
 
 def _render(engine, scene, size=(40, 30), **kw):
@@ -81,8 +41,8 @@ RHO, LE = 0.5, 1.0
 
 @pytest.fixture(scope="module")
 def furnace():
-    quads = _box_quads((-1, -1, -1), (1, 1, 1), 0)
-    return _scene(quads, [Material("wall", (RHO,) * 3, emission=(LE,) * 3)], [], (0.0, -0.5, 0.1), (0.3, 1.0, -0.2))
+    quads = box_quads((-1, -1, -1), (1, 1, 1), 0)
+    return quad_scene(quads, [Material("wall", (RHO,) * 3, emission=(LE,) * 3)], [], (0.0, -0.5, 0.1), (0.3, 1.0, -0.2))
 
 
 @pytest.mark.parametrize("anisotropic", [False, True])
@@ -158,9 +118,9 @@ def _view_factor_floor(p, n, floor_lo, floor_hi, samples=40000):
 
 def test_lit_floor_lights_the_wall_and_nothing_lights_the_floor(engine):
     sun = Light("sun", "SUN", (1, 1, 1), 3.0, np.eye(4))  # straight down: the wall gets no direct light
-    floor = _quad([(-2, -2, 0), (2, -2, 0), (2, 1, 0), (-2, 1, 0)], (0, 0, 1))
-    wall = _quad([(-2, 1, 0), (2, 1, 0), (2, 1, 2), (-2, 1, 2)], (0, -1, 0))
-    scene = _scene([(floor, 0), (wall, 0)], [Material("white", (0.8, 0.8, 0.8))], [sun], (0, -4, 3), (0, 0.5, 0.3),
+    floor = quad([(-2, -2, 0), (2, -2, 0), (2, 1, 0), (-2, 1, 0)], (0, 0, 1))
+    wall = quad([(-2, 1, 0), (2, 1, 0), (2, 1, 2), (-2, 1, 2)], (0, -1, 0))
+    scene = quad_scene([(floor, 0), (wall, 0)], [Material("white", (0.8, 0.8, 0.8))], [sun], (0, -4, 3), (0, 0.5, 0.3),
                    lens=20.0)
     r = _render(engine, scene, size=(80, 60), bounces=1)
     di, pos = r.passes["Diffuse Indirect"][..., 0], r.passes["Position"]
@@ -184,22 +144,6 @@ def test_lit_floor_lights_the_wall_and_nothing_lights_the_floor(engine):
     assert float(di[on_floor].max()) < 1e-4
 
 
-def _patch_view_factor(points, normals, patch, radiance, m=120):
-    """Exact irradiance / π at `points` (normals) from a Lambertian floor rectangle (x0, x1, y0, y1) at z = 0 of
-    `radiance`, unoccluded: midpoint rule over m × m cells."""
-    x0, x1, y0, y1 = patch
-    u = (np.arange(m) + 0.5) / m
-    gx, gy = np.meshgrid(x0 + (x1 - x0) * u, y0 + (y1 - y0) * u)
-    q = np.stack([gx, gy, np.zeros_like(gx)], -1).reshape(-1, 3)
-    out = []
-    for p, n in zip(points, normals):
-        v = q - p
-        r2 = (v * v).sum(-1)
-        cos_p, cos_q = np.clip(v @ n, 0, None) / np.sqrt(r2), np.clip(-v[:, 2], 0, None) / np.sqrt(r2)
-        out.append(radiance * (cos_p * cos_q / r2).sum() * (x1 - x0) * (y1 - y0) / m ** 2 / math.pi)
-    return np.array(out)
-
-
 @pytest.mark.parametrize("receiver", ["plate above", "wall beside"])
 def test_a_lit_patch_in_a_dark_floor_matches_its_view_factor(engine, receiver):
     """A 3 × 2.5 m lit patch in a black 6 × 6 m floor, seen from a plate 3 m above it and from a wall 1.5 m beside
@@ -212,21 +156,21 @@ def test_a_lit_patch_in_a_dark_floor_matches_its_view_factor(engine, receiver):
     x0, x1, y0, y1 = patch
 
     def floor(a, b, c, d, m):
-        return _quad([(a, c, 0), (b, c, 0), (b, d, 0), (a, d, 0)], (0, 0, 1)), m
+        return quad([(a, c, 0), (b, c, 0), (b, d, 0), (a, d, 0)], (0, 0, 1)), m
     quads = [floor(*patch, 1), floor(-3, x0, -3, 3, 0), floor(x1, 3, -3, 3, 0), floor(x0, x1, -3, y0, 0),
              floor(x0, x1, y1, 3, 0),
-             (_quad([(-1, -1, 3), (1, -1, 3), (1, 1, 3), (-1, 1, 3)], (0, 0, -1)), 2),
-             (_quad([(-3, -3, 0), (-3, 3, 0), (-3, 3, 3), (-3, -3, 3)], (1, 0, 0)), 2)]
+             (quad([(-1, -1, 3), (1, -1, 3), (1, 1, 3), (-1, 1, 3)], (0, 0, -1)), 2),
+             (quad([(-3, -3, 0), (-3, 3, 0), (-3, 3, 3), (-3, -3, 3)], (1, 0, 0)), 2)]
     mats = [Material("black", (0.0,) * 3), Material("patch", (0.7,) * 3), Material("grey", (0.5,) * 3)]
     # Sun 60° from vertical, towards +y: the plate's shadow falls beyond the floor, the wall (normal +x) gets none.
     sun = Light("sun", "SUN", (1, 1, 1), 2.0, np.linalg.inv(cam.look_at((0, -math.sqrt(3), 1), (0, 0, 0), (1, 0, 0))))
     eye, target = ((0.0, -1.9, 1.0), (0.0, 0.0, 3.0)) if receiver == "plate above" else ((2.5, 0, 1.5), (-3, 0, 1.3))
-    r = _render(engine, _scene(quads, mats, [sun], eye, target), resolution=64, bounces=1)
+    r = _render(engine, quad_scene(quads, mats, [sun], eye, target), resolution=64, bounces=1)
     pos, nrm, di = r.passes["Position"], r.passes["Normal"], r.passes["Diffuse Indirect"][..., 0]
     ys, xs = np.nonzero((r.passes["Depth"][..., 0] < 1e9) & (pos[..., 2] > 1e-3))
     ys, xs = ys[::3], xs[::3]
     assert len(ys) > 50
-    exact = _patch_view_factor(pos[ys, xs, :3].astype(np.float64), nrm[ys, xs, :3].astype(np.float64), patch,
+    exact = patch_view_factor(pos[ys, xs, :3].astype(np.float64), nrm[ys, xs, :3].astype(np.float64), patch,
                                0.7 * 2.0 * 0.5 / math.pi)
     ours = di[ys, xs]
     ratio, rel_l1 = ours.sum() / exact.sum(), np.abs(ours - exact).sum() / exact.sum()
@@ -250,9 +194,9 @@ def _volumes(engine, scene, anisotropic):
 
 def _sunlit_room():
     sun = Light("sun", "SUN", (1, 1, 1), 4.0, np.linalg.inv(cam.look_at((1, -1, 3), (0, 0, 0), (0, 0, 1))))
-    quads = _box_quads((-1, -1, 0), (1, 1, 2), 0, skip=((2, "hi"),))  # open top
-    quads += _box_quads((-0.3, -0.3, 0.0), (0.3, 0.3, 0.7), 1, inward=False)
-    return _scene(quads, [Material("white", (0.7, 0.7, 0.7)), Material("red", (0.8, 0.2, 0.1))], [sun],
+    quads = box_quads((-1, -1, 0), (1, 1, 2), 0, skip=((2, "hi"),))  # open top
+    quads += box_quads((-0.3, -0.3, 0.0), (0.3, 0.3, 0.7), 1, inward=False)
+    return quad_scene(quads, [Material("white", (0.7, 0.7, 0.7)), Material("red", (0.8, 0.2, 0.1))], [sun],
                   (0.0, -0.9, 1.5), (0.0, 0.5, 0.3))
 
 
@@ -271,9 +215,9 @@ def test_isotropic_mip_conserves_emission(engine):
 @pytest.mark.parametrize("anisotropic", [False, True])
 def test_a_wall_one_voxel_thick_stays_opaque_at_every_level(engine, anisotropic):
     wall_x = 0.05  # a wall across the whole grid, normal along x
-    quads = [(_quad([(wall_x, -1, 0), (wall_x, 1, 0), (wall_x, 1, 2), (wall_x, -1, 2)], (-1, 0, 0)), 0)]
-    quads += [(_quad([(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)], (0, 0, 1)), 0)]  # a floor, for the extent
-    scene = _scene(quads, [Material("grey", (0.5, 0.5, 0.5))], [Light("p", "POINT", (1, 1, 1), 50.0,
+    quads = [(quad([(wall_x, -1, 0), (wall_x, 1, 0), (wall_x, 1, 2), (wall_x, -1, 2)], (-1, 0, 0)), 0)]
+    quads += [(quad([(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)], (0, 0, 1)), 0)]  # a floor, for the extent
+    scene = quad_scene(quads, [Material("grey", (0.5, 0.5, 0.5))], [Light("p", "POINT", (1, 1, 1), 50.0,
                    np.array([[1, 0, 0, -0.5], [0, 1, 0, 0], [0, 0, 1, 1], [0, 0, 0, 1.0]]))], (-0.9, -0.9, 1.5),
                    (0, 0, 0.5))
     grid, volumes = _volumes(engine, scene, anisotropic)
@@ -291,11 +235,11 @@ def test_a_wall_one_voxel_thick_stays_opaque_at_every_level(engine, anisotropic)
 def test_thin_wall_leak_isotropic_vs_anisotropic(engine):
     """Two rooms sharing a wall at x = 0, a point light in the left one: no light can reach the right room."""
     white = 0
-    quads = _box_quads((-2, -1, 0), (2, 1, 2), white)
-    quads += [(_quad([(0, -1, 0), (0, 1, 0), (0, 1, 2), (0, -1, 2)], (1, 0, 0)), white)]
+    quads = box_quads((-2, -1, 0), (2, 1, 2), white)
+    quads += [(quad([(0, -1, 0), (0, 1, 0), (0, 1, 2), (0, -1, 2)], (1, 0, 0)), white)]
     light = Light("bulb", "POINT", (1, 1, 1), 200.0, np.array([[1, 0, 0, -1.0], [0, 1, 0, 0], [0, 0, 1, 1.5],
                                                                 [0, 0, 0, 1.0]]))
-    scene = _scene(quads, [Material("white", (0.8, 0.8, 0.8))], [light], (0.0, -0.95, 1.9), (0.0, 1.0, 0.2),
+    scene = quad_scene(quads, [Material("white", (0.8, 0.8, 0.8))], [light], (0.0, -0.95, 1.9), (0.0, 1.0, 0.2),
                    lens=10.0)
     leaks = {}
     for anisotropic, bounces in ((False, 1), (True, 1), (True, 8)):
@@ -326,15 +270,15 @@ def test_a_sunlit_roof_top_does_not_light_the_room_below(engine):
     white roof as with a black one before the layer test of cone_step (vct_common.glsl); measured 1.000 since, and
     with the per-pixel sub-rays (vct_crossing.glsl: a sub-ray under the roof never crosses it). Bound 2%, for float
     rounding across drivers."""
-    walls = _box_quads((-1.5, -1.5, 0), (1.5, 1.5, 2), 0, skip=((2, "hi"),))
-    roof = [(_quad([(a, c, 2), (b, c, 2), (b, d, 2), (a, d, 2)], (0, 0, -1)), 1)
+    walls = box_quads((-1.5, -1.5, 0), (1.5, 1.5, 2), 0, skip=((2, "hi"),))
+    roof = [(quad([(a, c, 2), (b, c, 2), (b, d, 2), (a, d, 2)], (0, 0, -1)), 1)
             for a, b, c, d in ((-1.5, 1.5, 0.3, 1.5), (-1.5, 1.5, -1.5, -0.3), (-1.5, -0.3, -0.3, 0.3),
                                (0.3, 1.5, -0.3, 0.3))]
     sun = Light("sun", "SUN", (1, 1, 1), 5.0, np.eye(4))
     upper = {}
     for roof_albedo in (0.8, 0.0):
         mats = [Material("white", (0.7, 0.7, 0.7)), Material("roof", (roof_albedo,) * 3)]
-        scene = _scene(walls + roof, mats, [sun], (1.2, -1.2, 0.6), (-1.5, 1.5, 1.6), lens=14.0)
+        scene = quad_scene(walls + roof, mats, [sun], (1.2, -1.2, 0.6), (-1.5, 1.5, 1.6), lens=14.0)
         r = _render(engine, scene, size=(60, 45), bounces=1)
         di, pos, nrm = r.passes["Diffuse Indirect"].mean(axis=-1), r.passes["Position"], r.passes["Normal"]
         on_wall = (r.passes["Depth"][..., 0] < 1e9) & (np.abs(nrm[..., 2]) < 0.1) & (pos[..., 2] > 1.2)
@@ -347,8 +291,8 @@ def test_a_sunlit_roof_top_does_not_light_the_room_below(engine):
 # --------------------------------------------------------------------------------- pipeline: passes, AO, info
 def test_passes_rerun_only_downstream_and_ao_is_sky_visibility(engine, furnace):
     sun = Light("sun", "SUN", (1, 1, 1), 3.0, np.eye(4))
-    floor = _quad([(-2, -2, 0), (2, -2, 0), (2, 2, 0), (-2, 2, 0)], (0, 0, 1))
-    scene = _scene([(floor, 0)], [Material("white", (0.8, 0.8, 0.8))], [sun], (0, -3, 2), (0, 0, 0), lens=20.0)
+    floor = quad([(-2, -2, 0), (2, -2, 0), (2, 2, 0), (-2, 2, 0)], (0, 0, 1))
+    scene = quad_scene([(floor, 0)], [Material("white", (0.8, 0.8, 0.8))], [sun], (0, -3, 2), (0, 0, 0), lens=20.0)
     r = _render(engine, scene, bounces=1)
     assert r.info["grid"] == [32, 32, 8] and r.info["levels"] == vct.mip_levels(32) and r.info["anisotropic"]
     assert r.info["occupied_voxels"] > 0 and len(r.info["bounces"]) == 1
@@ -448,7 +392,7 @@ def test_second_ring_is_turned_half_a_sector():
 
 
 def test_grid_is_padded_so_mip_levels_nest():
-    scene = _scene(_box_quads((0, 0, 0), (3.0, 2.0, 0.4), 0), [Material("m")], [], (1, -3, 1), (1, 1, 0.2))
+    scene = quad_scene(box_quads((0, 0, 0), (3.0, 2.0, 0.4), 0), [Material("m")], [], (1, -3, 1), (1, 1, 0.2))
     s = VctSettings(resolution=64)
     grid = vct.vct_grid(scene, s)
     align = 2 ** (vct.mip_levels(64) - 1)

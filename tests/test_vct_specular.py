@@ -14,7 +14,7 @@ from bounce_gi.gpu_kernels.engine import Engine
 from bounce_gi.gpu_kernels.pipeline import PASS_NAMES, RenderSettings
 from bounce_gi.gpu_kernels.scene import Light, Material
 from bounce_gi.gpu_kernels.vct import VctSettings
-from test_vct import _quad, _scene
+from support.synthetic import quad, quad_scene
 
 SUN, WALL_RHO, WALL_TOP = 4.0, 0.8, 1.2
 L_WALL = WALL_RHO * SUN / math.pi
@@ -29,9 +29,9 @@ def _floor_scene(floor: Material):
     # Sun shining along +y (local −z → +y): the wall (normal −y) gets S at normal incidence, the floor none.
     m = np.array([[1, 0, 0, 0], [0, 0, -1, 0], [0, 1, 0, 0], [0, 0, 0, 1.0]])
     sun = Light("sun", "SUN", (1, 1, 1), SUN, m)
-    fl = _quad([(-2, -2, 0), (2, -2, 0), (2, 1, 0), (-2, 1, 0)], (0, 0, 1))
-    wall = _quad([(-2, 1, 0), (2, 1, 0), (2, 1, WALL_TOP), (-2, 1, WALL_TOP)], (0, -1, 0))
-    return _scene([(fl, 0), (wall, 1)], [floor, Material("wall", (WALL_RHO,) * 3)], [sun], (0, -4, 1.2),
+    fl = quad([(-2, -2, 0), (2, -2, 0), (2, 1, 0), (-2, 1, 0)], (0, 0, 1))
+    wall = quad([(-2, 1, 0), (2, 1, 0), (2, 1, WALL_TOP), (-2, 1, WALL_TOP)], (0, -1, 0))
+    return quad_scene([(fl, 0), (wall, 1)], [floor, Material("wall", (WALL_RHO,) * 3)], [sun], (0, -4, 1.2),
                   (0, 0.5, 0.2), lens=20.0)
 
 

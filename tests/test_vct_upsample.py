@@ -17,7 +17,8 @@ from bounce_gi.gpu_kernels.engine import Engine
 from bounce_gi.gpu_kernels.pipeline import RenderSettings
 from bounce_gi.gpu_kernels.scene import Camera, Material
 from bounce_gi.gpu_kernels.vct import VctSettings
-from test_vct import _quad, _scene, _sunlit_room
+from support.synthetic import quad, quad_scene
+from test_vct import _sunlit_room
 
 W, H = 64, 48
 SIGMA = 0.0625  # plane-distance scale (m): half a voxel of a 32³ grid over 4 m
@@ -29,14 +30,14 @@ def engine():
 
 
 def _top_view(with_plate: bool):
-    quads = [(_quad([(-2, -2, 0), (2, -2, 0), (2, 2, 0), (-2, 2, 0)], (0, 0, 1)), 0)]
+    quads = [(quad([(-2, -2, 0), (2, -2, 0), (2, 2, 0), (-2, 2, 0)], (0, 0, 1)), 0)]
     if with_plate:
-        quads.append((_quad([(-0.6, -0.5, 1), (0.6, -0.5, 1), (0.6, 0.5, 1), (-0.6, 0.5, 1)], (0, 0, 1)), 0))
+        quads.append((quad([(-0.6, -0.5, 1), (0.6, -0.5, 1), (0.6, 0.5, 1), (-0.6, 0.5, 1)], (0, 0, 1)), 0))
         # Two strips 8 cm (1.3 px) wide at the plate's height: thinner than the sample spacing, so some of their
         # pixels have no sample on their surface and must be traced at full resolution.
-        quads.append((_quad([(-1.5, 1.2, 1), (1.5, 1.2, 1), (1.5, 1.28, 1), (-1.5, 1.28, 1)], (0, 0, 1)), 0))
-        quads.append((_quad([(1.2, -1.5, 1), (1.28, -1.5, 1), (1.28, 0.9, 1), (1.2, 0.9, 1)], (0, 0, 1)), 0))
-    scene = _scene(quads, [Material("grey")], [], (0, -1, 1), (0, 0, 0))
+        quads.append((quad([(-1.5, 1.2, 1), (1.5, 1.2, 1), (1.5, 1.28, 1), (-1.5, 1.28, 1)], (0, 0, 1)), 0))
+        quads.append((quad([(1.2, -1.5, 1), (1.28, -1.5, 1), (1.28, 0.9, 1), (1.2, 0.9, 1)], (0, 0, 1)), 0))
+    scene = quad_scene(quads, [Material("grey")], [], (0, -1, 1), (0, 0, 0))
     c2w = np.linalg.inv(cam.look_at((0.0, 0.0, 5.0), (0.0, 0.0, 0.0), (0.0, 1.0, 0.0)))
     scene.camera = Camera(c2w, type="ORTHO", ortho_scale=3.8)
     return scene

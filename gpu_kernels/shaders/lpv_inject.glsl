@@ -2,6 +2,8 @@
 // its intensity (Φ/π)·max(0, n·ω) is projected on 2-band SH and added to the cell half a cell in front of it.
 // Accumulation is exact fixed point (integer atomics; no float atomics here), scaled by u_fixed_scale.
 // Because Φ carries the texel's world area, the result does not depend on the RSM resolution.
+// MODE_LIST: the same VPLs are written to a list instead (two slots per block; w = 1 marks a VPL), for the gathered
+// first bounce (lpv_gather.glsl).
 #include "lights_common.glsl"
 #include "light_eval.glsl"
 #include "lpv_fixed.glsl"
@@ -24,6 +26,15 @@ struct RsmView {
     vec4 right;    // xyz right vector of the view; w: unused (with axis and up: tangent-plane coordinates)
 };
 layout(std430, binding = 3) readonly buffer RsmViewBuffer { RsmView rsm_views[]; };
+#if defined(MODE_LIST)
+struct Vpl {
+    vec4 position;  // xyz, w = 1
+    vec4 normal;    // xyz unit normal
+    vec4 flux;      // rgb (W)
+};
+layout(std430, binding = 6) writeonly buffer VplList { Vpl vpls[]; };
+uniform int u_blocks_x;           // blocks per atlas row: the list slot of a block
+#endif
 
 // Solid angle of one texel of a perspective view with tan(half fov) m at tangent-plane point (x, y):
 // (2m/res)² / (1 + x² + y²)^(3/2).
@@ -77,26 +88,47 @@ vec3 vpl_flux(RsmView v, vec3 p, vec3 n, vec3 albedo) {
 }
 
 void main() {
-    // Intensity-aware clustering (seed 001 N.5.2): a k×k block of RSM texels becomes one VPL with the block's total
+    // Intensity-aware clustering (seed 001 N.5.2): a k×k block of RSM texels becomes a VPL with the block's total
     // flux, at the luminance-weighted mean position and normal — flux is kept exactly, and the VPL sits where the
-    // light is. Blocks never straddle views: tiles are multiples of 16 texels and k divides 16.
+    // light is. A block can span two surfaces (a sunlit roof and, through its opening, the floor 3 m below): their
+    // mean would float in the air between them, so texels off the plane of the block's first lit texel (normal
+    // more than ~25° away, or more than half a cell from its plane) form a second VPL. Blocks never straddle views:
+    // tiles are multiples of 16 texels and k divides 16.
     ivec2 block = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(block * u_downsample, u_rsm_size))) return;
-    vec3 flux = vec3(0.0), position = vec3(0.0), normal = vec3(0.0);
-    float weight = 0.0;
+    vec3 flux[2] = vec3[2](vec3(0.0), vec3(0.0));
+    vec3 position[2] = vec3[2](vec3(0.0), vec3(0.0));
+    vec3 normal[2] = vec3[2](vec3(0.0), vec3(0.0));
+    float weight[2] = float[2](0.0, 0.0);
+    bool has_plane = false;
+    vec3 plane_p = vec3(0.0), plane_n = vec3(0.0);
     for (int j = 0; j < u_downsample; ++j)
         for (int i = 0; i < u_downsample; ++i) {
             ivec2 px = block * u_downsample + ivec2(i, j);
             vec4 pos = texelFetch(u_rsm_position, px, 0);
             if (pos.w < 0.5) continue;
             vec3 n = normalize(texelFetch(u_rsm_normal, px, 0).xyz);
+            if (!has_plane) {
+                has_plane = true;
+                plane_p = pos.xyz;
+                plane_n = n;
+            }
+            int c = (dot(n, plane_n) > 0.9 && abs(dot(pos.xyz - plane_p, plane_n)) < 0.5 * u_grid_cell) ? 0 : 1;
             vec3 f = vpl_flux(rsm_views[int(pos.w - 0.5)], pos.xyz, n, texelFetch(u_rsm_albedo, px, 0).rgb);
             float w = dot(f, vec3(0.2126, 0.7152, 0.0722));  // Rec.709 luminance
-            flux += f;
-            position += w * pos.xyz;
-            normal += w * n;
-            weight += w;
+            flux[c] += f;
+            position[c] += w * pos.xyz;
+            normal[c] += w * n;
+            weight[c] += w;
         }
-    if (weight <= 0.0 || dot(normal, normal) == 0.0) return;
-    inject_lambertian(LpvGrid(u_grid_origin, u_grid_cell, u_grid_size), position / weight, normalize(normal), flux);
+    for (int c = 0; c < 2; ++c) {
+        if (weight[c] <= 0.0 || dot(normal[c], normal[c]) == 0.0) continue;
+#if defined(MODE_LIST)
+        vpls[2 * (block.y * u_blocks_x + block.x) + c] = Vpl(vec4(position[c] / weight[c], 1.0),
+                                                              vec4(normalize(normal[c]), 0.0), vec4(flux[c], 0.0));
+#else
+        inject_lambertian(LpvGrid(u_grid_origin, u_grid_cell, u_grid_size), position[c] / weight[c],
+                          normalize(normal[c]), flux[c]);
+#endif
+    }
 }

@@ -39,20 +39,33 @@ vec3 flux_irradiance(int cascade, vec3 p, vec3 n) {
     vec3 t = (p - u_fine_origin[cascade]) / (0.5 * u_cell[cascade]) - 0.5;
     ivec3 base = ivec3(floor(t));
     vec3 f = t - vec3(base);
-    vec3 sum = vec3(0.0);
-    float wsum = 0.0;
+    vec3 sum = vec3(0.0), agreed = vec3(0.0);
+    float wsum = 0.0, agreed_w = 0.0;
     for (int k = 0; k < 8; ++k) {
         ivec3 o = ivec3(k & 1, (k >> 1) & 1, (k >> 2) & 1);
         ivec3 G = base + o;
         if (any(lessThan(G, ivec3(0))) || any(greaterThanEqual(G, u_fine_size[cascade]))) continue;
         vec4 front = texelFetch(u_front[cascade], G, 0);
         if (front.a <= 0.0) continue;
+        // Conservative voxelisation marks a surface lying near a voxel boundary in the voxels on both sides; the
+        // one behind it (centre more than half a voxel behind the point) holds this surface's back (a roof's
+        // sunlit top under its ceiling): skip it.
+        vec3 centre = u_fine_origin[cascade] + (vec3(G) + 0.5) * (0.5 * u_cell[cascade]);
+        if (dot(centre - p, n) < -0.3 * u_cell[cascade]) continue;
         vec3 nv = texelFetch(u_voxel_normal[cascade], G, 0).xyz;
         float w = (o.x == 1 ? f.x : 1.0 - f.x) * (o.y == 1 ? f.y : 1.0 - f.y) * (o.z == 1 ? f.z : 1.0 - f.z);
         vec3 e = dot(n, nv) >= 0.0 ? front.rgb : texelFetch(u_back[cascade], G, 0).rgb;
+        // A voxel whose surfaces face another way (a corner voxel holding a wall and the ceiling has a diagonal
+        // mean normal, and the irradiance of that diagonal) says little about this surface: voxels within ~35° of
+        // the normal count fully, beyond ~45° not at all — unless none is that close.
+        float agree = abs(dot(n, nv)) * inversesqrt(max(dot(nv, nv), 1e-20));
+        float aw = w * clamp((agree - 0.7) / 0.12, 0.0, 1.0);
         sum += w * e;
         wsum += w;
+        agreed += aw * e;
+        agreed_w += aw;
     }
+    if (agreed_w > 1e-3) return agreed / agreed_w;
     return wsum > 0.0 ? sum / wsum : vec3(0.0);
 }
 #endif

@@ -1,0 +1,139 @@
+"""The LPV's gathered transport (gpu_kernels/lpv_gather.py, the default): VPLs → surface voxels with fuzzy
+visibility, bounce by bounce, with the extrapolated tail. Exact oracles: the closed sphere's bounce series, a lit
+patch's view factor, a closed partition; and the clustering's flux bookkeeping.
+"""
+import math
+
+import numpy as np
+import pytest
+
+from bounce_gi.gpu_kernels import camera as cam
+from bounce_gi.gpu_kernels import lpv
+from bounce_gi.gpu_kernels.engine import Engine
+from bounce_gi.gpu_kernels.lpv_gather import VPL_DTYPE, merge
+from bounce_gi.gpu_kernels.pipeline import RenderSettings
+from bounce_gi.gpu_kernels.scene import Light, Material
+from support.synthetic import box_quads, patch_view_factor, quad, quad_scene
+from test_lpv import _sphere_scene
+
+
+@pytest.fixture(scope="module")
+def engine():
+    return Engine()
+
+
+def _render(engine, scene, size=(64, 48), **kw):
+    return engine.render(scene, RenderSettings("lpv", *size, lpv=lpv.LpvSettings(**kw)))
+
+
+def test_merging_keeps_the_flux_and_keeps_floor_and_wall_apart():
+    """VPLs on a floor (z = 0, normal +z) and a wall (x = 0, normal +x) meeting at a corner, merged in cubes that
+    hold both: the flux per channel must be kept to float32 rounding (1e-5), no merged VPL may mix the two (its
+    normal stays on its axis, its position on its plane), and areas add up."""
+    rng = np.random.default_rng(1)
+    n = 400
+    rec = np.zeros(2 * n, VPL_DTYPE)
+    rec["position"][:n, :3] = np.c_[rng.uniform(0, 1, n), rng.uniform(0, 1, n), np.zeros(n)]
+    rec["normal"][:n, :3] = (0, 0, 1)
+    rec["position"][n:, :3] = np.c_[np.zeros(n), rng.uniform(0, 1, n), rng.uniform(0, 1, n)]
+    rec["normal"][n:, :3] = (1, 0, 0)
+    rec["position"][:, 3] = 1.0
+    rec["normal"][:, 3] = 0.01
+    rec["flux"][:, :3] = rng.uniform(0.1, 1.0, (2 * n, 3))
+    out = merge(rec, 0.5)
+    assert 2 * 2 <= len(out) <= 2 * 8  # a 1 m square per surface, cubes of 0.5 m: 4 per surface (corner cubes hold both)
+    assert out["flux"][:, :3].sum(axis=0) == pytest.approx(rec["flux"][:, :3].sum(axis=0), rel=1e-5)
+    assert out["normal"][:, 3].sum() == pytest.approx(rec["normal"][:, 3].sum(), rel=1e-5)
+    floor = out["normal"][:, 2] > 0.999
+    wall = out["normal"][:, 0] > 0.999
+    assert (floor | wall).all()
+    assert np.abs(out["position"][floor, 2]).max() < 1e-6 and np.abs(out["position"][wall, 0]).max() < 1e-6
+
+
+def test_the_vpl_list_carries_the_injected_flux(engine):
+    """The gather's VPLs (clustered to fit `gather_vpls`) and the propagation's injection read the same RSM: the
+    same flux, whatever the budget (float32 sums: 1e-4)."""
+    scene = _sphere_scene()
+    propagated = _render(engine, scene, transport="propagate", bounces=1, max_iterations=4)
+    flux = [propagated.info["cascades"][0]["injected_flux"]]
+    for budget in (64, 512):
+        r = _render(engine, scene, bounces=1, gather_vpls=budget)
+        assert r.info["cascades"][0]["bounces"][0]["vpls"] <= budget
+        flux.append(r.info["cascades"][0]["injected_flux"])
+    print("injected flux, propagate / gather 64 / gather 512:", flux)
+    assert flux[1] == pytest.approx(flux[0], rel=1e-4) and flux[2] == pytest.approx(flux[0], rel=1e-4)
+
+
+@pytest.mark.parametrize("bounces,gathered", [(3, 0), (8, 3)])
+def test_closed_sphere_bounce_series_against_the_analytic_irradiance(engine, bounces, gathered):
+    """Inside a closed sphere of albedo ρ with a point light of flux Φ, every bounce is uniform and each is ρ times
+    the last: E = E₁·(1 − ρᴺ)/(1 − ρ), E₁ = ρΦ/(4πR²). Three bounces all gathered, and the default (8 bounces, 3
+    gathered, 5 extrapolated from the flux ratio — which must come out ρ). Measured at 32³: 1 bounce 0.991·E₁ (the
+    issue's ±15% test, test_lpv.py); here see the printout. Bounds: mean within 10% (the icosphere's facets and
+    the voxels' centres, off the surface by up to half a voxel, move each bounce by ~1–3%), every pixel within
+    ±25% of the mean (the series is uniform; the spread is the gather's quadrature), ratio ρ within 5%."""
+    rho = 0.5
+    r = _render(engine, _sphere_scene(subdivisions=4), resolution=32, bounces=bounces, gathered_bounces=gathered)
+    e1 = rho * 100.0 / (4 * math.pi)
+    expected = e1 * (1 - rho ** bounces) / (1 - rho)
+    irradiance = r.passes["Diffuse Indirect"][..., 0] * math.pi
+    stats = r.info["cascades"][0]["bounces"]
+    print(f"sphere, {bounces} bounces ({gathered or 'all'} gathered): mean E / expected "
+          f"{irradiance.mean() / expected:.3f}, min {irradiance.min() / expected:.3f}, "
+          f"max {irradiance.max() / expected:.3f}; passes {stats}")
+    assert irradiance.mean() == pytest.approx(expected, rel=0.10)
+    assert irradiance.min() > 0.75 * irradiance.mean() and irradiance.max() < 1.25 * irradiance.mean()
+    if gathered:
+        assert stats[-1]["extrapolated"] == bounces - gathered
+        assert stats[-1]["ratio"][0] == pytest.approx(rho, rel=0.05)
+
+
+@pytest.mark.parametrize("receiver", ["plate above", "wall beside"])
+def test_a_lit_patch_in_a_dark_floor_matches_its_view_factor(engine, receiver):
+    """test_vct.py's case for the LPV: a 3 × 2.5 m sunlit patch in a black 6 × 6 m floor, seen from a plate 3 m
+    above and a wall 1.5 m beside it. One bounce; exact answer by quadrature. The propagating transport gives
+    (32³) see the closing note; the gather: see the printout. Bounds: mean within 10%, rel-L1 below 0.20 —
+    the patch's edges are resolved to a fine voxel (9.8 cm here) and its VPLs are clusters of up to 512."""
+    patch = (-1.5, 1.5, -1.25, 1.25)
+    x0, x1, y0, y1 = patch
+
+    def floor(a, b, c, d, m):
+        return quad([(a, c, 0), (b, c, 0), (b, d, 0), (a, d, 0)], (0, 0, 1)), m
+    quads = [floor(*patch, 1), floor(-3, x0, -3, 3, 0), floor(x1, 3, -3, 3, 0), floor(x0, x1, -3, y0, 0),
+             floor(x0, x1, y1, 3, 0),
+             (quad([(-1, -1, 3), (1, -1, 3), (1, 1, 3), (-1, 1, 3)], (0, 0, -1)), 2),
+             (quad([(-3, -3, 0), (-3, 3, 0), (-3, 3, 3), (-3, -3, 3)], (1, 0, 0)), 2)]
+    mats = [Material("black", (0.0,) * 3), Material("patch", (0.7,) * 3), Material("grey", (0.5,) * 3)]
+    sun = Light("sun", "SUN", (1, 1, 1), 2.0, np.linalg.inv(cam.look_at((0, -math.sqrt(3), 1), (0, 0, 0), (1, 0, 0))))
+    eye, target = ((0.0, -1.9, 1.0), (0.0, 0.0, 3.0)) if receiver == "plate above" else ((2.5, 0, 1.5), (-3, 0, 1.3))
+    r = _render(engine, quad_scene(quads, mats, [sun], eye, target), resolution=32, bounces=1)
+    pos, nrm, di = r.passes["Position"], r.passes["Normal"], r.passes["Diffuse Indirect"][..., 0]
+    ys, xs = np.nonzero((r.passes["Depth"][..., 0] < 1e9) & (pos[..., 2] > 1e-3))
+    ys, xs = ys[::3], xs[::3]
+    assert len(ys) > 50
+    exact = patch_view_factor(pos[ys, xs, :3].astype(np.float64), nrm[ys, xs, :3].astype(np.float64), patch,
+                              0.7 * 2.0 * 0.5 / math.pi)
+    ours = di[ys, xs]
+    ratio, rel_l1 = ours.sum() / exact.sum(), np.abs(ours - exact).sum() / exact.sum()
+    print(f"{receiver}: ours / exact view factor {ratio:.3f}, rel-L1 {rel_l1:.3f} over {len(ys)} pixels")
+    assert ratio == pytest.approx(1.0, abs=0.10)
+    assert rel_l1 < 0.20
+
+
+def test_a_closed_partition_stops_the_gathered_light(engine):
+    """Two 2 × 2 × 2 m rooms side by side, a closed 10 cm partition between them (thinner than a cell, 13.8 cm
+    here), a point light in the left one: no light can reach the right room (Cycles: exactly 0). The gather's
+    visibility meets the partition's planes. Measured: the dark room gets 0.03% (1 bounce) / 0.04% (3 bounces) of
+    the lit room's mean Diffuse Indirect; bound 1%. (Before the plane crossings, with a trilinear crossing density,
+    it was 2.2% / 4.7%: the density spread the partition over the rays that skimmed its foot.)"""
+    quads = box_quads((-2, -1, 0), (-0.05, 1, 2), 0) + box_quads((0.05, -1, 0), (2, 1, 2), 0)
+    mats = [Material("white", (0.7, 0.7, 0.7))]
+    light = [Light("bulb", "POINT", (1, 1, 1), 100.0, np.array([[1, 0, 0, -1.0], [0, 1, 0, 0], [0, 0, 1, 1.0],
+                                                                 [0, 0, 0, 1]]))]
+    means = []
+    for eye, target in (((-1.9, 0.0, 1.0), (0.0, 0.0, 0.8)), ((1.9, 0.0, 1.0), (0.0, 0.0, 0.8))):
+        r = _render(engine, quad_scene(quads, mats, light, eye, target, lens=12.0), resolution=32, bounces=3)
+        means.append(float(r.passes["Diffuse Indirect"][..., 0].mean()))
+    print(f"mean Diffuse Indirect, lit room {means[0]:.4f}, dark room {means[1]:.6f} ({means[1] / means[0]:.3%})")
+    assert means[0] > 0
+    assert means[1] < 0.01 * means[0]
