@@ -26,7 +26,7 @@ from .bench_report import pareto, row_label, speedups, summary_markdown, write_p
 QUICK_RES = (96, 72)
 QUALITY_FILE = "quality_front.json"  # what the bench writes for automatic quality (quality.py reads it)
 # The settings a sweep varies per method; the summary names rows by these.
-SWEPT_KEYS = {"lpv": ("resolution", "cascades", "max_iterations", "bounces"),
+SWEPT_KEYS = {"lpv": ("transport", "resolution", "cascades", "gather_vpls", "max_iterations", "bounces"),
               "vct": ("resolution", "diffuse_cones", "bounces", "gathered_bounces", "indirect_scale")}
 FLIP_CODE = ("import sys, flip_evaluator as f; "
              "print('FLIP', float(f.evaluate(sys.argv[1], sys.argv[2], 'LDR', applyMagma=False)[1]))")
@@ -52,9 +52,12 @@ def sweep(quick: bool, width: int, height: int) -> list:
 
     base = RenderSettings(width=width, height=height)
     rows = [("none", {}, replace(base, method="none"), True)]
+    # LPV: the gathered transport (default) from its cheap corner (16³, 1 bounce) to twice the VPLs and three
+    # cascades; the propagating transport at the 3 bounces it was measured with, and with 16 iterations.
     lpv = [dict(resolution=16, bounces=1), {}] if quick else [
         dict(resolution=16, bounces=1), dict(resolution=16), dict(resolution=32, bounces=1), {},
-        dict(max_iterations=16), dict(cascades=3)]
+        dict(gather_vpls=1024), dict(cascades=3), dict(transport="propagate", bounces=3),
+        dict(transport="propagate", bounces=3, max_iterations=16)]
     # VCT: the cheap corner (32³, 6 cones, 1 bounce), a fast multi-bounce point, the single bounce at 64³, the
     # default, every bounce gathered (what the extrapolated tail saves), 128³, and reduced-resolution tracing.
     vct = [dict(resolution=32, diffuse_cones=6, bounces=1), {}] if quick else [

@@ -2,6 +2,7 @@
 Prints a table (median of --repeats full re-renders after a warm-up); asserts nothing.
 
     .venv/bin/python benchmarks/lpv_bench.py [--scenes cornell spot_room courtyard] [--res 160 120] [--samples 64]
+                                             [--transports gather propagate]
 
 --octree: seed 002's Table 1 instead — per-step ms (inject, downsample, propagate, merge, lighting) and iteration
 counts of the octree LPV (k = 4 per level) against the uniform grid (k = 16 and the adaptive default), at 32³, with
@@ -15,8 +16,10 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
-CONFIGS = [dict(resolution=32, cascades=1), dict(resolution=32, cascades=3), dict(resolution=64, cascades=1),
-           dict(resolution=64, cascades=3)]
+# Both transports (gpu_kernels/lpv_gather.py): the gather at its defaults (8 bounces, 4 gathered), the propagation
+# at 3 bounces as it was measured before the gather existed.
+CONFIGS = [dict(transport=t, resolution=n, cascades=c, **({} if t == "gather" else {"bounces": 3}))
+           for t in ("gather", "propagate") for n in (32, 64) for c in (1, 3)]
 PASSES = ("rsm", "lpv_inject", "geometry_volume", "lpv_propagate", "lpv_lighting")
 OCTREE_CONFIGS = [("uniform k=16", dict(max_iterations=16, epsilon=0.0)), ("uniform adaptive", dict()),
                   ("uniform k=16 int 1b", dict(max_iterations=16, epsilon=0.0, lookup="intensity", bounces=1)),
@@ -31,8 +34,9 @@ def main():
     parser.add_argument("--scenes", nargs="+", default=["cornell", "spot_room", "courtyard"])
     parser.add_argument("--res", nargs=2, type=int, default=(160, 120))
     parser.add_argument("--samples", type=int, default=64, help="Cycles samples per seed (0: skip the errors)")
-    parser.add_argument("--bounces", type=int, default=3)
+    parser.add_argument("--bounces", type=int, default=None, help="override every configuration's bounce count")
     parser.add_argument("--repeats", type=int, default=2)
+    parser.add_argument("--transports", nargs="+", default=["gather", "propagate"], choices=["gather", "propagate"])
     parser.add_argument("--octree", action="store_true", help="seed 002 Table 1: octree vs uniform at 32³")
     args = parser.parse_args()
 
@@ -47,10 +51,12 @@ def main():
     from examples import scenes
 
     engine = Engine()
-    print(f"GL: {engine.gl_info()['renderer']}; image {args.res[0]}x{args.res[1]}; bounces {args.bounces}")
+    print(f"GL: {engine.gl_info()['renderer']}; image {args.res[0]}x{args.res[1]}; bounces "
+          f"{args.bounces or 'gather 8 (4 gathered), propagate 3'}")
     if args.octree:
         return octree_table(args, engine, scenes, extract_scene, render_reference, ReferenceSettings, metrics)
-    header = f"{'scene':<11}{'grid':>6}{'casc':>5}{'iters':>7}" + "".join(f"{p:>16}" for p in PASSES) + \
+    header = f"{'scene':<11}{'transport':>10}{'grid':>6}{'casc':>5}{'iters':>7}{'VPLs':>7}" + \
+        "".join(f"{p:>16}" for p in PASSES) + \
         f"{'total ms':>10}{'DI relL1':>10}{'Comb relL1':>11}"
     print(header)
     for name in args.scenes:
@@ -59,8 +65,9 @@ def main():
         ref = None
         if args.samples:
             ref = render_reference(scene.content_hash(), ReferenceSettings(*args.res, samples=args.samples))
-        for cfg in CONFIGS:
-            settings = RenderSettings("lpv", *args.res, lpv=LpvSettings(bounces=args.bounces, **cfg))
+        for cfg in (c for c in CONFIGS if c["transport"] in args.transports):
+            settings = RenderSettings("lpv", *args.res, lpv=LpvSettings(
+                **{**cfg, **({"bounces": args.bounces} if args.bounces else {})}))
             engine.render(scene, settings)  # warm-up: compiles shaders
             runs = []
             for _ in range(args.repeats):
@@ -72,12 +79,13 @@ def main():
             result = runs[-1][1]
             times = [statistics.median(r[1].timings.get(p, 0.0) for r in runs) * 1000 for p in PASSES]
             iters = sum(c["iterations"] for c in result.info["cascades"])
+            vpls = sum(b.get("vpls", 0) for c in result.info["cascades"] for b in c["bounces"])
             errors = ""
             if ref is not None:
                 mask = (ref.passes["Depth"][..., 0] < 1e9) & (result.passes["Depth"][..., 0] < 1e9)
                 errors = (f"{metrics.rel_l1(result.passes['Diffuse Indirect'], ref.passes['Diffuse Indirect'], mask):>10.3f}"
                           f"{metrics.rel_l1(result.passes['Combined'], ref.passes['Combined'], mask):>11.3f}")
-            print(f"{name:<11}{cfg['resolution']:>5}³{cfg['cascades']:>5}{iters:>7}" +
+            print(f"{name:<11}{cfg['transport']:>10}{cfg['resolution']:>5}³{cfg['cascades']:>5}{iters:>7}{vpls:>7}" +
                   "".join(f"{t:>16.1f}" for t in times) + f"{total * 1000:>10.0f}" + errors, flush=True)
 
 
@@ -111,8 +119,8 @@ def octree_table(args, engine, scenes, extract_scene, render_reference, Referenc
                                     f"Combined {ref.noise_floor('Combined'):.3f})" if ref else ""))
         print(f"{'config':<21}{'iters':>12}" + "".join(f"{c:>11}" for c in cols) + f"{'DI relL1':>10}{'Comb':>8}")
         for label, cfg in OCTREE_CONFIGS:
-            settings = RenderSettings("lpv", *args.res, lpv=LpvSettings(resolution=32, **{"bounces": args.bounces,
-                                                                                           **cfg}))
+            settings = RenderSettings("lpv", *args.res, lpv=LpvSettings(
+                resolution=32, transport="propagate", **{"bounces": args.bounces or 3, **cfg}))
             runs = _timed(engine, scene, settings, args.repeats)
             result = runs[-1][1]
             ms = {p: statistics.median(r[1].timings.get(p, 0.0) for r in runs) * 1000 for p in OCTREE_PASSES}

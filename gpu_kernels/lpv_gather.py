@@ -189,14 +189,15 @@ def gather(ctx, programs, state: LpvGridState, gv, vpls: VplList, occlusion: boo
         direct._set(prog, name, unit)
     direct._set(prog, "u_occlusion", bool(occlusion))
     direct._set(prog, "u_fine_origin", tuple(float(c) for c in gv.fine.origin))
-    direct._set(prog, "u_fine_size", tuple(gv.fine.size))
     _grid_uniforms(prog, state.grid)
     vpls.buffer.bind_to_storage_buffer(6)
+    gv.surfaces.bind_to_storage_buffer(7)
+    direct._set(prog, "u_surface_count", int(gv.surface_count))
     for unit, name in enumerate(("front", "back", "front_total", "back_total")):
         getattr(state, name).bind_to_image(unit, read=True, write=True)
     chunk = vpls_per_dispatch(state.grid)
     for first in range(0, vpls.count, chunk):
         direct._set(prog, "u_vpl_first", first)
         direct._set(prog, "u_vpl_count", min(chunk, vpls.count - first))
-        prog.run(*((n + 3) // 4 for n in gv.fine.size))
+        prog.run((gv.surface_count + 63) // 64, 1, 1)
         ctx.memory_barrier()

@@ -23,9 +23,11 @@ class GeometryVolume:
     albedo: object
     coverage: object = None  # per LPV cell (crossing_layers): its surfaces' plane(s) and covered fraction
     layers: object = None  # per LPV cell: where those planes lie (cells from the grid origin)
+    surfaces: object = None  # storage buffer: (x, y, z, 0) int32 of every fine voxel holding a surface
+    surface_count: int = 0
 
     def release(self):
-        for t in (self.blocking, self.area, self.normal, self.albedo, self.coverage, self.layers):
+        for t in (self.blocking, self.area, self.normal, self.albedo, self.coverage, self.layers, self.surfaces):
             if t is not None:
                 t.release()
 
@@ -128,7 +130,12 @@ def geometry_volumes(ctx, programs, scene: Scene, geometry, textures, grids: lis
         for t in crossings:
             t.filter = (moderngl.NEAREST, moderngl.NEAREST)
         vox.emission.release()
-        out.append(GeometryVolume(tex, fine, vox.area, vox.normal, vox.albedo, *crossings))
+        # The gather runs over this list, not the whole fine grid: a workgroup straddling a wall would leave most
+        # of its SIMD lanes idle for the whole VPL loop.
+        z, y, x = np.nonzero(area[..., 3] > 0)
+        cells = np.stack([x, y, z, np.zeros_like(x)], axis=1).astype(np.int32)
+        surfaces = ctx.buffer(cells.tobytes() if len(cells) else np.zeros(4, np.int32).tobytes())
+        out.append(GeometryVolume(tex, fine, vox.area, vox.normal, vox.albedo, *crossings, surfaces, len(cells)))
     return out
 
 

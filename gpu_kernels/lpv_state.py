@@ -36,7 +36,7 @@ class LpvSettings:
     bounces: int = 8  # indirect bounces (1 = light reflected once; Cycles' default 8); > 1 need occlusion
     # Gathered transport: gather this many bounces, extrapolate the rest to `bounces` as a geometric series of the
     # last pass (lpv_tail.glsl); 0 = gather every bounce. The propagating transport propagates every bounce.
-    gathered_bounces: int = 3
+    gathered_bounces: int = 4
     lookup: str = "flux"  # "flux": absorbed face flux per area (conserves energy); "intensity": Kaplanyan's I/cell²
     # Octree LPV (seed 002, lpv_octree.py): 0 = uniform grid; L ≥ 1 = full octree O_0..O_{L-1} (O_0 = this grid,
     # O_i = n/2^i), index volume, per-level propagation, merge (L = 1: the octree path with one level, which equals

@@ -132,7 +132,8 @@ class Pipeline:
     def _lpv(self, scene, settings, geometry, textures, shadows, gbuffer, k_geometry, k_materials, k_shadow,
              k_gbuffer):
         """LPV passes: rsm ← shadow views; geometry_volume ← geometry, grids; lpv_inject ← rsm, grids, world;
-        lpv_propagate ← injection, geometry volume, LPV settings; lpv_lighting ← gbuffer, propagation."""
+        lpv_propagate ← injection, geometry volume, LPV settings (the transport: the gather's bounces or the
+        propagation, lpv.gather_all / lpv.propagate_all); lpv_lighting ← gbuffer, transport."""
         ctx, programs, cache, s = self.ctx, self.programs, self.cache, settings.lpv
         grids = lpv.cascade_grids(scene, s)
         k_grids = tuple(g.key() for g in grids)

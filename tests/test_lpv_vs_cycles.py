@@ -1,45 +1,84 @@
-"""LPV against Cycles on the typical interiors (issue: Light Propagation Volumes) — regression bounds.
+"""LPV against Cycles on the typical interiors (issue: Light Propagation Volumes) — accuracy and regression bounds.
 
 160×120, 32³ grid, Cycles 128 spp × 2 seeds. Two comparisons on each typical interior, as the issue asks: with
-full bounces (ours 3, Cycles 8) and with the same single bounce on both sides. The bounds hold today's measured
-errors × 1.05 + 0.05: the references are seeded (the same Cycles build renders the same noise), so the margin is for
-a different Cycles build or GL driver moving the noise — on Diffuse Indirect the noise floor is ~0.07 here, and
-half of it can move our rel-L1 either way; errors well above 1 come from pixels the reference has nearly black,
-hence the relative part. They are NOT the issue's targets (Diffuse Indirect ≤ 25%, Combined ≤ 10%), and they are
-far from them: the 2-band propagation is diffusive, and the measured one-bounce spot room has 2.6× Cycles'
-indirect light, nearly all of it on the spot-lit floor itself — the floor's own VPLs, injected half a cell above
-it, spread sideways (the 2-band clamped-cosine lobe is 1/3 of its peak at 90°) and the floor's blocking potential
-stops that flux at the floor (see the closing note of the LPV work). A change that makes LPV worse fails here; one
-that makes it better should lower these bounds.
+full bounces (8 on both sides) and with the same single bounce on both sides; for both transports.
+
+The gathered transport (default, gpu_kernels/lpv_gather.py) meets the issue's targets (Diffuse Indirect ≤ 25%,
+Combined ≤ 10% against full-bounce Cycles): against 2048-spp references (noise floor DI 0.025 / 0.018 / 0.031)
+it measures 0.071 / 0.040, 0.088 / 0.034, 0.069 / 0.051 (Cornell, spot room, courtyard). Against the 128-spp
+references held here the numbers below are higher by the references' own noise (DI noise floor ~0.07; the
+courtyard's Combined floor is 0.08, so its 0.099 is mostly Cycles' noise). The bounds hold today's measured
+errors × 1.05 + 0.05: the references are seeded (the same Cycles build renders the same noise), so the margin is
+for a different Cycles build or GL driver moving the noise.
+
+The propagating transport (the Kaplanyan–Dachsbacher face scheme, `transport=propagate`) is far from the targets:
+the 2-band propagation is diffusive — a lobe pointing up keeps 0.096 of its flux going up per step — so light
+from a lit floor turns sideways and returns to the floor; the one-bounce spot room has 2.9× Cycles' indirect
+light, nearly all on the spot-lit floor itself. Its bounds are regression bounds on today's level.
+A change that makes either worse fails here; one that makes it better should lower these bounds.
 """
 import pytest
 
-# measured, rel-L1 Diffuse Indirect / Combined (full bounces): cornell 0.692 / 0.331, spot_room 1.233 / 0.472,
-# courtyard 0.967 / 0.657
-FULL = {"cornell": {"diffuse_indirect": 0.78, "combined": 0.40},
-        "spot_room": {"diffuse_indirect": 1.35, "combined": 0.55},
-        "courtyard": {"diffuse_indirect": 1.07, "combined": 0.74}}
-# measured (1 bounce each side): cornell 0.887 / 0.309, spot_room 2.878 / 0.439, courtyard 1.907 / 0.739
-ONE_BOUNCE = {"cornell": {"diffuse_indirect": 0.99, "combined": 0.38},
-              "spot_room": {"diffuse_indirect": 3.07, "combined": 0.52},
-              "courtyard": {"diffuse_indirect": 2.06, "combined": 0.83}}
+SCENES = ("cornell", "spot_room", "courtyard")
+# measured, rel-L1 Diffuse Indirect / Combined (8 bounces): cornell 0.108 / 0.055, spot_room 0.115 / 0.044,
+# courtyard 0.140 / 0.099
+GATHER_FULL = {"cornell": {"diffuse_indirect": 0.17, "combined": 0.11},
+               "spot_room": {"diffuse_indirect": 0.18, "combined": 0.10},
+               "courtyard": {"diffuse_indirect": 0.20, "combined": 0.16}}
+# measured (1 bounce each side): cornell 0.089 / 0.037, spot_room 0.072 / 0.010, courtyard 0.095 / 0.046
+GATHER_ONE_BOUNCE = {"cornell": {"diffuse_indirect": 0.15, "combined": 0.09},
+                     "spot_room": {"diffuse_indirect": 0.13, "combined": 0.07},
+                     "courtyard": {"diffuse_indirect": 0.15, "combined": 0.10}}
+# propagate, measured (ours 3 bounces, Cycles 8): cornell 0.687 / 0.328, spot_room 1.237 / 0.474,
+# courtyard 0.971 / 0.660
+PROPAGATE_FULL = {"cornell": {"diffuse_indirect": 0.78, "combined": 0.40},
+                  "spot_room": {"diffuse_indirect": 1.35, "combined": 0.55},
+                  "courtyard": {"diffuse_indirect": 1.07, "combined": 0.74}}
+# propagate, measured (1 bounce each side): cornell 0.885 / 0.309, spot_room 2.892 / 0.441, courtyard 1.867 / 0.724
+PROPAGATE_ONE_BOUNCE = {"cornell": {"diffuse_indirect": 0.99, "combined": 0.38},
+                        "spot_room": {"diffuse_indirect": 3.09, "combined": 0.52},
+                        "courtyard": {"diffuse_indirect": 2.06, "combined": 0.83}}
+TARGETS = {"diffuse_indirect": 0.25, "combined": 0.10}  # the issue's, against 2048-spp Cycles (see above)
 
 
 @pytest.fixture(scope="module")
-def full(compare_examples):
-    return compare_examples(128, list(FULL), "--method", "lpv", "--lpv", "bounces=3")
+def gather_full(compare_examples):
+    return compare_examples(128, list(SCENES), "--method", "lpv")
 
 
 @pytest.fixture(scope="module")
-def one_bounce(compare_examples):
-    return compare_examples(128, list(ONE_BOUNCE), "--method", "lpv", "--bounces", 1, "--lpv", "bounces=1")
+def gather_one_bounce(compare_examples):
+    return compare_examples(128, list(SCENES), "--method", "lpv", "--bounces", 1, "--lpv", "bounces=1")
 
 
-@pytest.mark.parametrize("name", list(FULL))
-def test_lpv_full_bounce_error_does_not_regress(full, name, check_bounds):
-    check_bounds(full[name], FULL[name])
+@pytest.fixture(scope="module")
+def propagate_full(compare_examples):
+    return compare_examples(128, list(SCENES), "--method", "lpv", "--lpv", "transport=propagate", "bounces=3")
 
 
-@pytest.mark.parametrize("name", list(ONE_BOUNCE))
-def test_lpv_one_bounce_error_does_not_regress(one_bounce, name, check_bounds):
-    check_bounds(one_bounce[name], ONE_BOUNCE[name])
+@pytest.fixture(scope="module")
+def propagate_one_bounce(compare_examples):
+    return compare_examples(128, list(SCENES), "--method", "lpv", "--bounces", 1, "--lpv", "transport=propagate",
+                            "bounces=1")
+
+
+@pytest.mark.parametrize("name", SCENES)
+def test_gathered_lpv_full_bounce_error(gather_full, name, check_bounds):
+    check_bounds(gather_full[name], GATHER_FULL[name])
+    if name != "courtyard":  # the courtyard's 128-spp Combined noise floor (0.08) leaves no room under 0.10
+        check_bounds(gather_full[name], TARGETS)
+
+
+@pytest.mark.parametrize("name", SCENES)
+def test_gathered_lpv_one_bounce_error(gather_one_bounce, name, check_bounds):
+    check_bounds(gather_one_bounce[name], GATHER_ONE_BOUNCE[name])
+
+
+@pytest.mark.parametrize("name", SCENES)
+def test_propagated_lpv_full_bounce_error_does_not_regress(propagate_full, name, check_bounds):
+    check_bounds(propagate_full[name], PROPAGATE_FULL[name])
+
+
+@pytest.mark.parametrize("name", SCENES)
+def test_propagated_lpv_one_bounce_error_does_not_regress(propagate_one_bounce, name, check_bounds):
+    check_bounds(propagate_one_bounce[name], PROPAGATE_ONE_BOUNCE[name])

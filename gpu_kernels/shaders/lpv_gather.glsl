@@ -21,13 +21,15 @@
 // lookup (lpv_lighting.glsl, MODE_FLUX) reads it unchanged; the next bounce's VPLs come from it (lpv_cluster.glsl).
 #include "lpv_common.glsl"
 
-layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
+layout(local_size_x = 64) in;
 struct Vpl {
     vec4 position;  // xyz, w = 1
     vec4 normal;    // xyz unit normal, w = area (m²) or 0
     vec4 flux;      // rgb (W)
 };
 layout(std430, binding = 6) readonly buffer VplList { Vpl vpls[]; };
+layout(std430, binding = 7) readonly buffer SurfaceVoxels { ivec4 surfaces[]; };  // fine voxels with surfaces
+uniform int u_surface_count;
 uniform int u_vpl_first;           // this dispatch's VPLs: [first, first + count) (see lpv_gather.gather)
 uniform int u_vpl_count;
 uniform sampler3D u_voxel_normal;   // fine voxels: mean sign-canonical normal
@@ -36,7 +38,6 @@ uniform sampler3D u_coverage;       // LPV cells: covered fraction of the x/y/z 
 uniform sampler3D u_layers;         // LPV cells: where those surfaces lie along x/y/z, in cells
 uniform bool u_occlusion;
 uniform vec3 u_fine_origin;
-uniform ivec3 u_fine_size;
 uniform vec3 u_grid_origin;
 uniform float u_grid_cell;
 uniform ivec3 u_grid_size;
@@ -100,8 +101,8 @@ float transmittance(vec3 from, vec3 dir, float dist) {
 }
 
 void main() {
-    ivec3 f = ivec3(gl_GlobalInvocationID);
-    if (any(greaterThanEqual(f, u_fine_size))) return;
+    if (int(gl_GlobalInvocationID.x) >= u_surface_count) return;
+    ivec3 f = surfaces[gl_GlobalInvocationID.x].xyz;
     vec4 area = texelFetch(u_voxel_area, f, 0);
     vec3 nv = texelFetch(u_voxel_normal, f, 0).xyz;
     if (area.a <= 0.0 || dot(nv, nv) == 0.0) return;
@@ -123,11 +124,11 @@ void main() {
         float dist = sqrt(d2);
         vec3 w = d / dist;
         float receive = dot(nv, -w);  // > 0: the VPL is on the voxel's front side (as in lpv_absorb.glsl)
-        float area = max(PI * h * h, v.normal.w);
+        float source_area = max(PI * h * h, v.normal.w);
         float t = transmittance(v.position.xyz, w, dist);
         if (t <= 0.0) continue;
-        if (d2 > NEAR_FIELD * area / PI) {
-            vec3 e = v.flux.rgb * (height / dist * abs(receive) * t / (PI * d2 + area));
+        if (d2 > NEAR_FIELD * source_area / PI) {
+            vec3 e = v.flux.rgb * (height / dist * abs(receive) * t / (PI * d2 + source_area));
             if (receive > 0.0) front += e; else back += e;
             continue;
         }
@@ -136,13 +137,13 @@ void main() {
         // (0.6 radii out along the diagonals), each with a quarter of the flux and area. Visibility: the centroid's.
         vec3 t1 = normalize(abs(nl.x) < 0.9 ? cross(nl, vec3(1.0, 0.0, 0.0)) : cross(nl, vec3(0.0, 1.0, 0.0)));
         vec3 t2 = cross(nl, t1);
-        float r = 0.6 * 0.70710678 * sqrt(area / PI);
+        float r = 0.6 * 0.70710678 * sqrt(source_area / PI);
         for (int q = 0; q < 4; ++q) {
             vec3 ds = d - r * ((q & 1) == 0 ? t1 : -t1) - r * ((q & 2) == 0 ? t2 : -t2);
             float s2 = dot(ds, ds);
             vec3 ws = ds * inversesqrt(s2);
             float rs = dot(nv, -ws);
-            vec3 e = v.flux.rgb * (0.25 * dot(nl, ws) * abs(rs) * t / (PI * s2 + 0.25 * area));
+            vec3 e = v.flux.rgb * (0.25 * dot(nl, ws) * abs(rs) * t / (PI * s2 + 0.25 * source_area));
             if (rs > 0.0) front += e; else back += e;
         }
     }
