@@ -26,7 +26,7 @@ class LpvSettings:
     resolution: int = 32  # cells along the longest axis of the (finest) grid
     cascades: int = 1  # nested grids, each twice the extent of the last
     rsm_resolution: int = 128  # texels per side of each RSM view (sun: twice that)
-    rsm_downsample: int = 1  # k: inject one VPL per k×k RSM texels, intensity-aware (seed 001); 1, 2 or 4
+    rsm_downsample: int = 1  # propagate: inject one VPL per k×k RSM texels, intensity-aware (seed 001); 1, 2, 4
     max_iterations: int = 64
     epsilon: float = 1e-3  # stop when one step moved less than this fraction of the injected flux
     occlusion: bool = True  # fuzzy occlusion from the geometry volume

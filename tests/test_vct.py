@@ -22,7 +22,7 @@ from bounce_gi.gpu_kernels.engine import Engine
 from bounce_gi.gpu_kernels.pipeline import RenderSettings
 from bounce_gi.gpu_kernels.scene import Light, Material
 from bounce_gi.gpu_kernels.vct import VctSettings
-from support.synthetic import box_quads, patch_view_factor, quad, quad_scene
+from support.synthetic import box_quads, lit_patch_error, lit_patch_scene, quad, quad_scene
 
 
 @pytest.fixture(scope="module")
@@ -152,29 +152,10 @@ def test_a_lit_patch_in_a_dark_floor_matches_its_view_factor(engine, receiver):
     the floor without meeting it: the plate came out 1.61× and the wall 1.51× the exact integral (64³, 19 cones).
     Measured since: plate 0.963 (per-sample rel-L1 0.059), wall 1.008 (0.083). Bounds: mean within 10%, rel-L1
     below 0.15 — the quadrature of 9 cones × 7 sub-rays and the voxel's size (6.4 cm) at the patch's edges."""
-    patch = (-1.5, 1.5, -1.25, 1.25)
-    x0, x1, y0, y1 = patch
-
-    def floor(a, b, c, d, m):
-        return quad([(a, c, 0), (b, c, 0), (b, d, 0), (a, d, 0)], (0, 0, 1)), m
-    quads = [floor(*patch, 1), floor(-3, x0, -3, 3, 0), floor(x1, 3, -3, 3, 0), floor(x0, x1, -3, y0, 0),
-             floor(x0, x1, y1, 3, 0),
-             (quad([(-1, -1, 3), (1, -1, 3), (1, 1, 3), (-1, 1, 3)], (0, 0, -1)), 2),
-             (quad([(-3, -3, 0), (-3, 3, 0), (-3, 3, 3), (-3, -3, 3)], (1, 0, 0)), 2)]
-    mats = [Material("black", (0.0,) * 3), Material("patch", (0.7,) * 3), Material("grey", (0.5,) * 3)]
-    # Sun 60° from vertical, towards +y: the plate's shadow falls beyond the floor, the wall (normal +x) gets none.
-    sun = Light("sun", "SUN", (1, 1, 1), 2.0, np.linalg.inv(cam.look_at((0, -math.sqrt(3), 1), (0, 0, 0), (1, 0, 0))))
-    eye, target = ((0.0, -1.9, 1.0), (0.0, 0.0, 3.0)) if receiver == "plate above" else ((2.5, 0, 1.5), (-3, 0, 1.3))
-    r = _render(engine, quad_scene(quads, mats, [sun], eye, target), resolution=64, bounces=1)
-    pos, nrm, di = r.passes["Position"], r.passes["Normal"], r.passes["Diffuse Indirect"][..., 0]
-    ys, xs = np.nonzero((r.passes["Depth"][..., 0] < 1e9) & (pos[..., 2] > 1e-3))
-    ys, xs = ys[::3], xs[::3]
-    assert len(ys) > 50
-    exact = patch_view_factor(pos[ys, xs, :3].astype(np.float64), nrm[ys, xs, :3].astype(np.float64), patch,
-                               0.7 * 2.0 * 0.5 / math.pi)
-    ours = di[ys, xs]
-    ratio, rel_l1 = ours.sum() / exact.sum(), np.abs(ours - exact).sum() / exact.sum()
-    print(f"{receiver}: ours / exact view factor {ratio:.3f}, rel-L1 {rel_l1:.3f} over {len(ys)} pixels")
+    r = _render(engine, lit_patch_scene(receiver), resolution=64, bounces=1)
+    ratio, rel_l1, pixels = lit_patch_error(r.passes)
+    assert pixels > 50
+    print(f"{receiver}: ours / exact view factor {ratio:.3f}, rel-L1 {rel_l1:.3f} over {pixels} pixels")
     assert ratio == pytest.approx(1.0, abs=0.10)
     assert rel_l1 < 0.15
 

@@ -4,7 +4,7 @@ import math
 import numpy as np
 
 from bounce_gi.gpu_kernels import camera as cam
-from bounce_gi.gpu_kernels.scene import Camera, Scene, World
+from bounce_gi.gpu_kernels.scene import Camera, Light, Material, Scene, World
 
 
 def quad(corners, normal):
@@ -62,3 +62,37 @@ def patch_view_factor(points, normals, patch, radiance, m=120):
         cos_p, cos_q = np.clip(v @ n, 0, None) / np.sqrt(r2), np.clip(-v[:, 2], 0, None) / np.sqrt(r2)
         out.append(radiance * (cos_p * cos_q / r2).sum() * (x1 - x0) * (y1 - y0) / m ** 2 / math.pi)
     return np.array(out)
+
+
+LIT_PATCH = (-1.5, 1.5, -1.25, 1.25)  # x0, x1, y0, y1 of the sunlit patch (albedo 0.7, sun 2 W/m² at 60°)
+
+
+def lit_patch_scene(receiver: str) -> Scene:
+    """A 3 × 2.5 m lit patch in a black 6 × 6 m floor, a grey plate 3 m above it and a grey wall 1.5 m beside it,
+    the camera on the plate ("plate above") or the wall ("wall beside"). The sun, 60° from vertical towards +y,
+    casts the plate's shadow beyond the floor and gives the wall (normal +x) none: the receivers' indirect light is
+    the patch's alone (`lit_patch_error`)."""
+    x0, x1, y0, y1 = LIT_PATCH
+
+    def floor(a, b, c, d, m):
+        return quad([(a, c, 0), (b, c, 0), (b, d, 0), (a, d, 0)], (0, 0, 1)), m
+    quads = [floor(*LIT_PATCH, 1), floor(-3, x0, -3, 3, 0), floor(x1, 3, -3, 3, 0), floor(x0, x1, -3, y0, 0),
+             floor(x0, x1, y1, 3, 0),
+             (quad([(-1, -1, 3), (1, -1, 3), (1, 1, 3), (-1, 1, 3)], (0, 0, -1)), 2),
+             (quad([(-3, -3, 0), (-3, 3, 0), (-3, 3, 3), (-3, -3, 3)], (1, 0, 0)), 2)]
+    mats = [Material("black", (0.0,) * 3), Material("patch", (0.7,) * 3), Material("grey", (0.5,) * 3)]
+    sun = Light("sun", "SUN", (1, 1, 1), 2.0, np.linalg.inv(cam.look_at((0, -math.sqrt(3), 1), (0, 0, 0), (1, 0, 0))))
+    eye, target = ((0.0, -1.9, 1.0), (0.0, 0.0, 3.0)) if receiver == "plate above" else ((2.5, 0, 1.5), (-3, 0, 1.3))
+    return quad_scene(quads, mats, [sun], eye, target)
+
+
+def lit_patch_error(passes) -> tuple[float, float, int]:
+    """(mean ours / exact, rel-L1 against exact, pixels) of a render of `lit_patch_scene`'s Diffuse Indirect,
+    over every third receiver pixel (the patch's radiance: 0.7 × 2 W/m² × cos 60° / π)."""
+    pos, nrm, di = passes["Position"], passes["Normal"], passes["Diffuse Indirect"][..., 0]
+    ys, xs = np.nonzero((passes["Depth"][..., 0] < 1e9) & (pos[..., 2] > 1e-3))
+    ys, xs = ys[::3], xs[::3]
+    exact = patch_view_factor(pos[ys, xs, :3].astype(np.float64), nrm[ys, xs, :3].astype(np.float64), LIT_PATCH,
+                              0.7 * 2.0 * 0.5 / math.pi)
+    ours = di[ys, xs]
+    return float(ours.sum() / exact.sum()), float(np.abs(ours - exact).sum() / exact.sum()), len(ys)
