@@ -33,8 +33,8 @@ FLIP_CODE = ("import sys, flip_evaluator as f; "
 
 
 def default_settings(method: str) -> dict:
-    from ..gpu_kernels.lpv import LpvSettings
-    from ..gpu_kernels.vct import VctSettings
+    from ..gpu_kernels.lpv.settings import LpvSettings
+    from ..gpu_kernels.vct.settings import VctSettings
 
     cls = {"lpv": LpvSettings, "vct": VctSettings}.get(method)
     return asdict(cls()) if cls else {}
@@ -46,9 +46,9 @@ def _finite(x):
 
 def sweep(quick: bool, width: int, height: int) -> list:
     """(method, settings dict, RenderSettings, default) for every row; default = the settings `render` uses."""
-    from ..gpu_kernels.lpv import LpvSettings
-    from ..gpu_kernels.pipeline import RenderSettings
-    from ..gpu_kernels.vct import VctSettings
+    from ..gpu_kernels.lpv.settings import LpvSettings
+    from ..gpu_kernels.settings import RenderSettings
+    from ..gpu_kernels.vct.settings import VctSettings
 
     base = RenderSettings(width=width, height=height)
     rows = [("none", {}, replace(base, method="none"), True)]
@@ -79,7 +79,7 @@ def geometry_mask(ours: dict, ref: dict):
 
 def flip_error(test_rgb, ref_rgb, tmp: str):
     """Mean FLIP of tone-mapped sRGB PNGs, computed in a subprocess; (value or None, warning or None)."""
-    from ..gpu_kernels import exr_io
+    from ..gpu_kernels.output import exr as exr_io
 
     ref_png, test_png = os.path.join(tmp, "flip_ref.png"), os.path.join(tmp, "flip_test.png")
     try:
@@ -126,7 +126,7 @@ def time_ours(engine, scene, settings, repeats: int):
 
 
 def bench_row(engine, scene, ref, row, repeats, extract_seconds, tmp, progress) -> dict:
-    from ..gpu_kernels import metrics
+    from ..gpu_kernels.output import metrics
 
     method, settings_dict, settings, default = row
     out = {"method": method, "settings": settings_dict, "default": default, "seconds": None, "passes": {},

@@ -78,7 +78,7 @@ def measure_incremental(scene_resolution, method: str, repeats: int = 3) -> dict
     import bpy
 
     from ..gpu_kernels.engine import get_engine
-    from ..gpu_kernels.pipeline import RenderSettings
+    from ..gpu_kernels.settings import RenderSettings
 
     engine = get_engine()
     w, h = scene_resolution

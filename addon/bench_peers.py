@@ -19,7 +19,7 @@ def _finite(x):
 
 
 def _render_exr(bpy, path: str) -> tuple:
-    from ..gpu_kernels import exr_io
+    from ..gpu_kernels.output import exr as exr_io
 
     bpy.context.scene.render.filepath = path
     start = time.perf_counter()
@@ -32,7 +32,7 @@ def render_peers(ref, mask, width, height, quick, progress, tmp, eevee=True) -> 
     """Cycles at a few sample counts without and with OIDN, then EEVEE; (peers, warnings)."""
     import bpy
 
-    from ..gpu_kernels import metrics
+    from ..gpu_kernels.output import metrics
     from .cycles_reference import ReferenceSettings, _configure, _saved, _settings_to_save
 
     scene, view_layer = bpy.context.scene, bpy.context.view_layer

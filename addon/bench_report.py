@@ -173,7 +173,7 @@ def write_plot(path: str, entry: dict) -> None:
     """Log-log time vs Combined rel-L1: our rows by method, our Pareto front, Cycles ± OIDN curves, EEVEE."""
     import OpenImageIO as oiio
 
-    from ..gpu_kernels import exr_io
+    from ..gpu_kernels.output import exr as exr_io
 
     ok = lambda p: p.get("seconds") and p["rel_l1"].get("combined")  # noqa: E731
     rows = [r for r in entry["rows"] if ok(r)]

@@ -19,7 +19,7 @@ def synthetic_scene(subdivisions: int, resolution=(320, 240)):
     """Floor (4 m square) + icosphere (radius 1 m, 20·4^subdivisions triangles) under a tilted sun."""
     import trimesh
 
-    from ..gpu_kernels import camera as cam
+    from ..gpu_kernels.common import camera as cam
     from ..gpu_kernels.scene import Camera, Light, Material, Scene, World
 
     sphere = trimesh.creation.icosphere(subdivisions=subdivisions, radius=1.0)
@@ -80,9 +80,9 @@ def _series(name, xs, measure, progress) -> dict:
 
 def run_scaling(quick: bool, progress, methods=("none", "lpv", "vct")) -> dict:
     from ..gpu_kernels.engine import get_engine
-    from ..gpu_kernels.lpv import LpvSettings
-    from ..gpu_kernels.pipeline import RenderSettings
-    from ..gpu_kernels.vct import VctSettings
+    from ..gpu_kernels.lpv.settings import LpvSettings
+    from ..gpu_kernels.settings import RenderSettings
+    from ..gpu_kernels.vct.settings import VctSettings
 
     engine = get_engine()
     repeats = 1 if quick else 3

@@ -99,7 +99,7 @@ def parse_method_options(pairs, settings_cls=None, flag: str = "--lpv") -> dict:
     import dataclasses
 
     if settings_cls is None:
-        from ..gpu_kernels.lpv import LpvSettings as settings_cls
+        from ..gpu_kernels.lpv.settings import LpvSettings as settings_cls
 
     fields = {f.name: f for f in dataclasses.fields(settings_cls)}
     out = {}
@@ -121,17 +121,17 @@ def parse_method_options(pairs, settings_cls=None, flag: str = "--lpv") -> dict:
 
 
 def vct_options(pairs) -> dict:
-    from ..gpu_kernels.vct import VctSettings
+    from ..gpu_kernels.vct.settings import VctSettings
 
     return parse_method_options(pairs, VctSettings, "--vct")
 
 
 def render_ours(scene, method: str, lpv_options: dict | None = None, vct_settings: dict | None = None):
     from ..gpu_kernels.engine import get_engine
-    from ..gpu_kernels.gpu_context import GpuUnavailableError
-    from ..gpu_kernels.lpv import LpvSettings
-    from ..gpu_kernels.pipeline import RenderSettings, SceneError
-    from ..gpu_kernels.vct import VctSettings
+    from ..gpu_kernels.gl.context import GpuUnavailableError
+    from ..gpu_kernels.lpv.settings import LpvSettings
+    from ..gpu_kernels.settings import RenderSettings, SceneError
+    from ..gpu_kernels.vct.settings import VctSettings
 
     try:
         lpv_settings = LpvSettings(**(lpv_options or {}))
@@ -163,8 +163,8 @@ def auto_quality(args) -> dict | None:
     args.method = choice.method
     import dataclasses
 
-    from ..gpu_kernels.lpv import LpvSettings
-    from ..gpu_kernels.vct import VctSettings
+    from ..gpu_kernels.lpv.settings import LpvSettings
+    from ..gpu_kernels.vct.settings import VctSettings
 
     cls = {"lpv": LpvSettings, "vct": VctSettings}.get(choice.method)
     known = {f.name for f in dataclasses.fields(cls)} if cls else set()
@@ -187,7 +187,7 @@ def cmd_render(args) -> dict:
         out = check_output_path(os.path.splitext(os.path.abspath(args.scene))[0] + f"_bounce_{args.method}.exr", ".exr")
     scene = load_scene(args.scene, tuple(args.res) if args.res else None)
     result = render_ours(scene, args.method, parse_method_options(args.lpv), vct_options(args.vct))
-    from ..gpu_kernels import exr_io
+    from ..gpu_kernels.output import exr as exr_io
 
     write_output(exr_io.write_passes, out, result.passes)
     report = {"method": result.method, "resolution": list(result.resolution),
@@ -218,7 +218,7 @@ def compare(scene, method: str, samples: int, bounces: int = 8, progress=_progre
     """Render ours and the (cached) two-seed Cycles reference of the currently open scene; return the errors."""
     import numpy as np
 
-    from ..gpu_kernels import metrics
+    from ..gpu_kernels.output import metrics
     from .cycles_reference import ReferenceSettings, render_reference
 
     result = render_ours(scene, method, lpv_options, vct_settings)
@@ -258,7 +258,8 @@ def cmd_compare(args) -> dict:
                                         lpv_options=parse_method_options(args.lpv),
                                         vct_settings=vct_options(args.vct))
     if heatmap:
-        from ..gpu_kernels import exr_io, metrics
+        from ..gpu_kernels.output import exr as exr_io
+        from ..gpu_kernels.output import metrics
 
         err = metrics.relative_error_map(result.passes["Combined"], ref.passes["Combined"]) * mask
         write_output(exr_io.write_png, heatmap, metrics.heatmap_rgb8(err))
@@ -322,7 +323,7 @@ class _ArgumentParser(argparse.ArgumentParser):
 
 
 def build_parser() -> argparse.ArgumentParser:
-    from ..gpu_kernels.pipeline import METHODS
+    from ..gpu_kernels.settings import METHODS
 
     parser = _ArgumentParser(prog="bounce-gi", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True)

@@ -17,7 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..gpu_kernels import exr_io, metrics
+from ..gpu_kernels.output import exr as exr_io
+from ..gpu_kernels.output import metrics
 
 PASS_FLAGS = ("use_pass_diffuse_direct", "use_pass_diffuse_indirect", "use_pass_diffuse_color", "use_pass_emit",
               "use_pass_normal", "use_pass_z", "use_pass_position", "use_pass_glossy_direct",

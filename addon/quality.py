@@ -90,9 +90,9 @@ def render_settings_for(choice: Choice, width: int, height: int):
     """The RenderSettings a Choice stands for (unknown keys from an older table are ignored)."""
     import dataclasses
 
-    from ..gpu_kernels.lpv import LpvSettings
-    from ..gpu_kernels.pipeline import RenderSettings
-    from ..gpu_kernels.vct import VctSettings
+    from ..gpu_kernels.lpv.settings import LpvSettings
+    from ..gpu_kernels.settings import RenderSettings
+    from ..gpu_kernels.vct.settings import VctSettings
 
     def build(cls):
         names = {f.name for f in dataclasses.fields(cls)}

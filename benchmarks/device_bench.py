@@ -76,7 +76,7 @@ def _timed(engine, scene, settings, repeats):
 
 
 def _errors(result, ref):
-    from bounce_gi.gpu_kernels import metrics
+    from bounce_gi.gpu_kernels.output import metrics
 
     if ref is None:
         return ""
@@ -86,9 +86,9 @@ def _errors(result, ref):
 
 
 def run(engine, scene_dir, grids, lpv_grids, repeats, say):
-    from bounce_gi.gpu_kernels.lpv import LpvSettings
-    from bounce_gi.gpu_kernels.pipeline import RenderSettings
-    from bounce_gi.gpu_kernels.vct import VctSettings
+    from bounce_gi.gpu_kernels.lpv.settings import LpvSettings
+    from bounce_gi.gpu_kernels.settings import RenderSettings
+    from bounce_gi.gpu_kernels.vct.settings import VctSettings
 
     say(f"\nVCT (defaults: {VctSettings().bounces} bounces, {VctSettings().gathered_bounces} gathered)")
     say(f"{'scene':<11}{'grid':>6}{'image':>9}" + "".join(f"{p[4:]:>10}" for p in VCT_PASSES) +
@@ -149,9 +149,9 @@ def _edited(scene, kind, sign):
 
 def incremental(engine, scene_dir, repeats, say):
     """Median seconds of one update after an edit in a long-lived engine (pass cache kept), per kind."""
-    from bounce_gi.gpu_kernels.lpv import LpvSettings
-    from bounce_gi.gpu_kernels.pipeline import RenderSettings
-    from bounce_gi.gpu_kernels.vct import VctSettings
+    from bounce_gi.gpu_kernels.lpv.settings import LpvSettings
+    from bounce_gi.gpu_kernels.settings import RenderSettings
+    from bounce_gi.gpu_kernels.vct.settings import VctSettings
 
     kinds = ("unchanged", "camera_only", "light_move", "material_change")
     say("\nIncremental updates (pass cache kept; median of %d edits, alternately +0.05 and −0.05), ms" % repeats)

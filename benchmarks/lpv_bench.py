@@ -44,10 +44,10 @@ def main():
 
     from bounce_gi.addon.cycles_reference import ReferenceSettings, render_reference
     from bounce_gi.addon.extract import extract_scene
-    from bounce_gi.gpu_kernels import metrics
+    from bounce_gi.gpu_kernels.output import metrics
     from bounce_gi.gpu_kernels.engine import Engine
-    from bounce_gi.gpu_kernels.lpv import LpvSettings
-    from bounce_gi.gpu_kernels.pipeline import RenderSettings
+    from bounce_gi.gpu_kernels.lpv.settings import LpvSettings
+    from bounce_gi.gpu_kernels.settings import RenderSettings
     from examples import scenes
 
     engine = Engine()
@@ -104,9 +104,9 @@ def _timed(engine, scene, settings, repeats):
 def octree_table(args, engine, scenes, extract_scene, render_reference, ReferenceSettings, metrics):
     import bpy
 
-    from bounce_gi.gpu_kernels import lpv_octree
-    from bounce_gi.gpu_kernels.lpv import LpvSettings
-    from bounce_gi.gpu_kernels.pipeline import RenderSettings
+    from bounce_gi.gpu_kernels.lpv import octree as lpv_octree
+    from bounce_gi.gpu_kernels.lpv.settings import LpvSettings
+    from bounce_gi.gpu_kernels.settings import RenderSettings
 
     cols = ("inject", "GV", "IX+GVdown", "downsample", "propagate", "merge", "lighting", "LPV total", "frame")
     for name in args.scenes:

@@ -23,7 +23,7 @@ def main():
 
     from bounce_gi.addon.extract import extract_scene
     from bounce_gi.gpu_kernels.engine import Engine
-    from bounce_gi.gpu_kernels.pipeline import RenderSettings
+    from bounce_gi.gpu_kernels.settings import RenderSettings
     from examples import scenes
 
     engine = Engine()

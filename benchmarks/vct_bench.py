@@ -55,10 +55,10 @@ def main():
 
     from bounce_gi.addon.cycles_reference import ReferenceSettings, render_reference
     from bounce_gi.addon.extract import extract_scene
-    from bounce_gi.gpu_kernels import metrics
+    from bounce_gi.gpu_kernels.output import metrics
     from bounce_gi.gpu_kernels.engine import Engine
-    from bounce_gi.gpu_kernels.pipeline import RenderSettings
-    from bounce_gi.gpu_kernels.vct import VctSettings
+    from bounce_gi.gpu_kernels.settings import RenderSettings
+    from bounce_gi.gpu_kernels.vct.settings import VctSettings
 
     if args.bounces is None:
         args.bounces = VctSettings().bounces

@@ -76,11 +76,11 @@ def main():
     parser.add_argument("--no-iou", action="store_true", help="skip trimesh (slow for big flat faces at 256³)")
     args = parser.parse_args()
 
-    from bounce_gi.gpu_kernels import direct
-    from bounce_gi.gpu_kernels import voxelize as vz
-    from bounce_gi.gpu_kernels.gpu_context import create_context
-    from bounce_gi.gpu_kernels.grid import Grid
-    from bounce_gi.gpu_kernels.programs import ProgramCache
+    from bounce_gi.gpu_kernels.direct import geometry as direct
+    from bounce_gi.gpu_kernels.voxel import voxelize as vz
+    from bounce_gi.gpu_kernels.gl.context import create_context
+    from bounce_gi.gpu_kernels.common.grid import Grid
+    from bounce_gi.gpu_kernels.gl.programs import ProgramCache
     from bounce_gi.gpu_kernels.scene import Material, Scene
 
     ctx = create_context()

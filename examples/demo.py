@@ -10,8 +10,9 @@ import sys
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 from bounce_gi.addon.cli import compare, format_compare, format_timings  # noqa: E402
-from bounce_gi.gpu_kernels import exr_io, metrics  # noqa: E402
-from bounce_gi.gpu_kernels.gpu_context import GpuUnavailableError  # noqa: E402
+from bounce_gi.gpu_kernels.output import exr as exr_io  # noqa: E402
+from bounce_gi.gpu_kernels.output import metrics
+from bounce_gi.gpu_kernels.gl.context import GpuUnavailableError  # noqa: E402
 
 
 def main() -> int:

@@ -4,9 +4,10 @@ from __future__ import annotations
 import threading
 from concurrent.futures import Future
 
-from .gpu_context import GpuWorker
-from .pipeline import Pipeline, RenderResult, RenderSettings, check_renderable
+from .gl.context import GpuWorker
+from .pipeline import Pipeline, RenderResult
 from .scene import Scene
+from .settings import RenderSettings, check_renderable
 
 _engine = None
 _lock = threading.Lock()

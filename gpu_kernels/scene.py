@@ -32,7 +32,7 @@ class Material:
     emission: tuple = (0.0, 0.0, 0.0)  # emission colour × strength (radiance, W/(m²·sr) per unit)
     roughness: float = 0.5
     metallic: float = 0.0
-    specular_layer: bool = False  # Principled: a dielectric GGX layer takes a view-dependent share (see gbuffer.glsl)
+    specular_layer: bool = False  # Principled: a dielectric GGX layer takes a view-dependent share (see direct/gbuffer.glsl)
 
 
 @dataclass
@@ -137,6 +137,14 @@ class Scene:
         h = hashlib.sha256()
         _hash_into(h, self)
         return h.hexdigest()[:20]
+
+
+def hash_parts(*parts) -> str:
+    """A SHA-1 of `parts` (arrays, dataclasses, lists, numbers, strings): the content keys of the pass cache."""
+    h = hashlib.sha1()
+    for p in parts:
+        _hash_into(h, p)
+    return h.hexdigest()
 
 
 def _hash_into(h, value) -> None:

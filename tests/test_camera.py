@@ -20,7 +20,7 @@ import textwrap
 import numpy as np
 import pytest
 
-from bounce_gi.gpu_kernels import camera as cam
+from bounce_gi.gpu_kernels.common import camera as cam
 from bounce_gi.gpu_kernels.scene import Camera
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))

@@ -187,7 +187,7 @@ def test_argparse_errors_exit_2_without_traceback(env, blends):
 
 
 def test_render_json_and_exr(env, blends, tmp_path):
-    from bounce_gi.gpu_kernels.exr_io import read_passes
+    from bounce_gi.gpu_kernels.output.exr import read_passes
 
     out = tmp_path / "cornell.exr"
     before = snapshot(blends)

@@ -9,7 +9,7 @@ import textwrap
 import numpy as np
 import pytest
 
-from bounce_gi.gpu_kernels import exr_io
+from bounce_gi.gpu_kernels.output import exr as exr_io
 
 oiio = pytest.importorskip("OpenImageIO")
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))

@@ -1,21 +1,21 @@
 """Every shader program the pipeline compiles fits the resource limits of real GPU drivers, not only llvmpipe's.
 
 Why: llvmpipe (the CI renderer) allows 32 image units per stage, NVIDIA's driver 8 — the OpenGL 4.3 minimum
-(GL_MAX_COMPUTE_IMAGE_UNIFORMS / GL_MAX_FRAGMENT_IMAGE_UNIFORMS). vct_inject.glsl once bound twelve images and VCT
+(GL_MAX_COMPUTE_IMAGE_UNIFORMS / GL_MAX_FRAGMENT_IMAGE_UNIFORMS). vct/inject.glsl once bound twelve images and VCT
 passed every test here but did not compile on an H200 ("invalid value 6 (array size 6) for layout specifier
 'binding'"). So: render with settings that reach every program variant, then count each program's image and
 sampler uniforms (array elements included) from the linked program. Samplers are held to 32, what NVIDIA, AMD,
-Intel and Mesa drivers all give per stage (the spec's minimum is 16; lpv_octree_merge.glsl uses 20, vct_bounce.glsl
+Intel and Mesa drivers all give per stage (the spec's minimum is 16; lpv/octree_merge.glsl uses 20, vct/bounce.glsl
 19).
 """
 import numpy as np
 import pytest
 
 from bounce_gi.gpu_kernels.engine import Engine
-from bounce_gi.gpu_kernels.lpv import LpvSettings
-from bounce_gi.gpu_kernels.pipeline import RenderSettings
+from bounce_gi.gpu_kernels.lpv.settings import LpvSettings
+from bounce_gi.gpu_kernels.settings import RenderSettings
 from bounce_gi.gpu_kernels.scene import Light, Material
-from bounce_gi.gpu_kernels.vct import VctSettings
+from bounce_gi.gpu_kernels.vct.settings import VctSettings
 from support.synthetic import quad, quad_scene
 
 MAX_IMAGES = 8
@@ -80,14 +80,14 @@ def programs():
 def test_every_program_fits_the_driver_minimums(programs):
     names = {key[1] for key in programs}
     # the check only means something if the render reached the heavy programs
-    for expected in ("vct_inject.glsl", "vct_bounce.glsl", "vct_mipmap.glsl", "lpv_propagate.glsl",
-                     "lpv_lighting.glsl"):
+    for expected in ("vct/inject.glsl", "vct/bounce.glsl", "vct/mipmap.glsl", "lpv/propagate.glsl",
+                     "lpv/lighting.glsl"):
         assert expected in names, (expected, sorted(names))
     too_many = {key: units for key, units in programs.items() if units[0] > MAX_IMAGES or units[1] > MAX_SAMPLERS}
     assert not too_many, f"(images, samplers) over ({MAX_IMAGES}, {MAX_SAMPLERS}): {too_many}"
 
 
 def test_the_counter_sees_image_arrays(programs):
-    # vct_bounce.glsl writes six face images (an image3D[6]); a counter that saw 0 or 1 would pass anything
-    bounce = [units for key, units in programs.items() if key[1] == "vct_bounce.glsl"]
+    # vct/bounce.glsl writes six face images (an image3D[6]); a counter that saw 0 or 1 would pass anything
+    bounce = [units for key, units in programs.items() if key[1] == "vct/bounce.glsl"]
     assert bounce and max(u[0] for u in bounce) == 6

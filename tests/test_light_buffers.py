@@ -6,11 +6,11 @@ import re
 import numpy as np
 import pytest
 
-from bounce_gi.gpu_kernels import light_buffers as lb
-from bounce_gi.gpu_kernels import shader_preprocessor as spp
+from bounce_gi.gpu_kernels.common import lights as lb
+from bounce_gi.gpu_kernels.gl import preprocessor as spp
 from bounce_gi.gpu_kernels.scene import Light, Material, Scene
 
-COMMON = spp.SHADER_DIR / "lights_common.glsl"
+COMMON = spp.SHADER_DIR / "common/lights.glsl"
 STRUCT_FOR_DTYPE = {"GpuLight": lb.LIGHT_DTYPE, "ShadowView": lb.VIEW_DTYPE}
 # std430 (GLSL 4.30 §7.6.2.2) base alignment and size of the types these structs may use.
 STD430 = {"float": (4, 4), "int": (4, 4), "uint": (4, 4), "vec2": (8, 8), "vec3": (16, 12), "vec4": (16, 16),
@@ -88,7 +88,7 @@ def gl():
 
 READBACK = """
 #version 430 core
-#include "lights_common.glsl"
+#include "common/lights.glsl"
 layout(local_size_x = 1) in;
 layout(std430, binding = 3) writeonly buffer Out { vec4 out_v[]; };
 uniform vec4 u_point;

@@ -12,13 +12,14 @@ import math
 import numpy as np
 import pytest
 
-from bounce_gi.gpu_kernels import lpv
+from bounce_gi.gpu_kernels.lpv.settings import LpvSettings
+from bounce_gi.gpu_kernels.lpv.propagate import step_fluxes
 from bounce_gi.gpu_kernels.engine import Engine
-from bounce_gi.gpu_kernels.grid import Grid
-from bounce_gi.gpu_kernels.pipeline import RenderSettings
-from bounce_gi.gpu_kernels.programs import ProgramCache
+from bounce_gi.gpu_kernels.common.grid import Grid
+from bounce_gi.gpu_kernels.settings import RenderSettings
+from bounce_gi.gpu_kernels.gl.programs import ProgramCache
 from bounce_gi.gpu_kernels.scene import Camera, Light, Material, Scene, World
-from bounce_gi.gpu_kernels import camera as cam
+from bounce_gi.gpu_kernels.common import camera as cam
 
 CLAMPED_COSINE = lambda n: np.array([0.886226925, -1.023326708 * n[1], 1.023326708 * n[2], -1.023326708 * n[0]])
 
@@ -37,8 +38,8 @@ def _point_vpl(grid, flux, normal):
 
 
 def _steps(engine, grid, initial, steps, **kw):
-    settings = lpv.LpvSettings(occlusion=False, **kw)
-    return engine.worker.call(lambda ctx: lpv.step_fluxes(ctx, ProgramCache(ctx), grid, initial, steps, settings))
+    settings = LpvSettings(occlusion=False, **kw)
+    return engine.worker.call(lambda ctx: step_fluxes(ctx, ProgramCache(ctx), grid, initial, steps, settings))
 
 
 def test_flux_is_conserved_per_step_in_empty_space(engine):
@@ -84,7 +85,7 @@ def test_injection_does_not_depend_on_rsm_resolution(engine):
     scene = _sphere_scene()
     injected = []
     for res in (64, 128):
-        r = engine.render(scene, RenderSettings("lpv", 64, 48, lpv=lpv.LpvSettings(rsm_resolution=res, bounces=1,
+        r = engine.render(scene, RenderSettings("lpv", 64, 48, lpv=LpvSettings(rsm_resolution=res, bounces=1,
                                                                                   max_iterations=8)))
         injected.append(r.info["cascades"][0]["injected_flux"])
     # Exact total: every ray of the bulb hits the sphere, so reflected flux = albedo × power per channel.
@@ -118,7 +119,7 @@ def test_closed_sphere_one_bounce_against_the_analytic_irradiance(engine, transp
     today's level (0.65–1.15, ±50% of the mean) as a regression bound.
     """
     scene = _sphere_scene(subdivisions=4)
-    r = engine.render(scene, RenderSettings("lpv", 96, 72, lpv=lpv.LpvSettings(resolution=32, bounces=1,
+    r = engine.render(scene, RenderSettings("lpv", 96, 72, lpv=LpvSettings(resolution=32, bounces=1,
                                                                               transport=transport)))
     e1 = 0.5 * 100.0 / (4 * math.pi)
     irradiance = r.passes["Diffuse Indirect"][..., 0] * math.pi
@@ -142,7 +143,7 @@ def test_cascades_agree_with_a_single_grid_where_they_overlap(engine):
     images = []
     means = []
     for cascades in (1, 3):
-        r = engine.render(scene, RenderSettings("lpv", 64, 48, lpv=lpv.LpvSettings(resolution=16, cascades=cascades,
+        r = engine.render(scene, RenderSettings("lpv", 64, 48, lpv=LpvSettings(resolution=16, cascades=cascades,
                                                                                   bounces=1)))
         di = r.passes["Diffuse Indirect"][..., 0]
         assert len(r.info["cascades"]) == cascades
@@ -165,7 +166,7 @@ def test_world_light_reaches_an_open_floor_and_not_a_closed_sphere(engine):
     cam_to_world = np.linalg.inv(cam.look_at(eye, (0, 0, 0), (0, 0, 1)))
     open_scene = Scene(floor, normals, np.zeros((2, 3, 2), np.float32), np.zeros(2, np.int32),
                        [Material("floor", (0.5, 0.5, 0.5))], [], [], World((1.0, 1.0, 1.0)), Camera(cam_to_world))
-    r = engine.render(open_scene, RenderSettings("lpv", 64, 48, lpv=lpv.LpvSettings(resolution=16, bounces=1)))
+    r = engine.render(open_scene, RenderSettings("lpv", 64, 48, lpv=LpvSettings(resolution=16, bounces=1)))
     hit = r.passes["Depth"][..., 0] < 1e9
     irradiance = r.passes["Diffuse Indirect"][..., 0][hit] * math.pi
     print("open floor under a white sky: mean E / π =", irradiance.mean() / math.pi)
@@ -175,7 +176,7 @@ def test_world_light_reaches_an_open_floor_and_not_a_closed_sphere(engine):
     sphere.lights = []
     sphere.world = World((1.0, 1.0, 1.0))
     sphere.materials[0].emission = (0.0, 0.0, 0.0)
-    r = engine.render(sphere, RenderSettings("lpv", 64, 48, lpv=lpv.LpvSettings(resolution=16, bounces=1)))
+    r = engine.render(sphere, RenderSettings("lpv", 64, 48, lpv=LpvSettings(resolution=16, bounces=1)))
     inside = r.passes["Diffuse Indirect"][..., 0] * math.pi
     print("inside a closed sphere: mean E / π =", inside.mean() / math.pi)
     assert inside.mean() < 0.25 * math.pi
@@ -189,7 +190,7 @@ def test_intensity_aware_rsm_downsampling_keeps_the_flux(engine, downsample):
     scene = _sphere_scene()
     results = []
     for k in (1, downsample):
-        r = engine.render(scene, RenderSettings("lpv", 64, 48, lpv=lpv.LpvSettings(
+        r = engine.render(scene, RenderSettings("lpv", 64, 48, lpv=LpvSettings(
             rsm_downsample=k, bounces=1, max_iterations=16, resolution=16, transport="propagate")))
         results.append(r)
     fluxes = [r.info["cascades"][0]["injected_flux"] for r in results]

@@ -7,10 +7,10 @@ import math
 import numpy as np
 import pytest
 
-from bounce_gi.gpu_kernels import lpv
+from bounce_gi.gpu_kernels.lpv.settings import LpvSettings
 from bounce_gi.gpu_kernels.engine import Engine
-from bounce_gi.gpu_kernels.lpv_gather import VPL_DTYPE, merge
-from bounce_gi.gpu_kernels.pipeline import RenderSettings
+from bounce_gi.gpu_kernels.lpv.gather import VPL_DTYPE, merge
+from bounce_gi.gpu_kernels.settings import RenderSettings
 from bounce_gi.gpu_kernels.scene import Light, Material
 from support.synthetic import box_quads, lit_patch_error, lit_patch_scene, quad_scene
 from test_lpv import _sphere_scene
@@ -22,7 +22,7 @@ def engine():
 
 
 def _render(engine, scene, size=(64, 48), **kw):
-    return engine.render(scene, RenderSettings("lpv", *size, lpv=lpv.LpvSettings(**kw)))
+    return engine.render(scene, RenderSettings("lpv", *size, lpv=LpvSettings(**kw)))
 
 
 def test_merging_keeps_the_flux_and_keeps_floor_and_wall_apart():

@@ -7,13 +7,14 @@ import math
 import numpy as np
 import pytest
 
-from bounce_gi.gpu_kernels import camera as cam
-from bounce_gi.gpu_kernels import lpv, lpv_octree
+from bounce_gi.gpu_kernels.common import camera as cam
+from bounce_gi.gpu_kernels.lpv.settings import LpvSettings
+from bounce_gi.gpu_kernels.lpv import octree as lpv_octree
 from bounce_gi.gpu_kernels.engine import Engine
-from bounce_gi.gpu_kernels.grid import Grid
-from bounce_gi.gpu_kernels.lpv_state import LpvGridState, _volumes
-from bounce_gi.gpu_kernels.pipeline import RenderSettings
-from bounce_gi.gpu_kernels.programs import ProgramCache
+from bounce_gi.gpu_kernels.common.grid import Grid
+from bounce_gi.gpu_kernels.lpv.state import LpvGridState, make_volumes
+from bounce_gi.gpu_kernels.settings import RenderSettings
+from bounce_gi.gpu_kernels.gl.programs import ProgramCache
 from bounce_gi.gpu_kernels.scene import Camera, Light, Material, Scene, World
 
 from test_lpv import _sphere_scene
@@ -45,7 +46,7 @@ def _floor_scene():
 
 
 def test_downsampling_sums_children_exactly(engine):
-    """Eq. 2 for a flux state (lpv_octree_downsample.glsl): every O_i cell is the sum of its eight O_{i-1} children,
+    """Eq. 2 for a flux state (lpv/octree_downsample.glsl): every O_i cell is the sum of its eight O_{i-1} children,
     so each level holds exactly O_0's flux. Random signed coefficients on an odd-sized 13×10×7 grid (the last parents
     are partly outside). Tolerance: float32 sums of 8 terms, 1e-6 relative to the largest value (an average would be
     off by a factor of 8)."""
@@ -57,7 +58,7 @@ def test_downsampling_sums_children_exactly(engine):
         programs = ProgramCache(ctx)
         state = LpvGridState(ctx, grid)
         state.injected.release()
-        state.injected = _volumes(ctx, grid, data)
+        state.injected = make_volumes(ctx, grid, data)
         state.injected_flux = 1.0
         geo = lpv_octree.OctreeGeometry(lpv_octree.level_grids(grid, 3), [], [], [])
         tree = lpv_octree.downsample(ctx, programs, state, geo)
@@ -70,7 +71,7 @@ def test_downsampling_sums_children_exactly(engine):
     expected = data.astype(np.float64)
     for i in range(1, 3):
         shape = levels[i].shape[:3]
-        expected = lpv_octree._pool(expected.reshape(expected.shape[:3] + (12,)), 2, shape, 0).reshape(shape + (3, 4))
+        expected = lpv_octree.pool(expected.reshape(expected.shape[:3] + (12,)), 2, shape, 0).reshape(shape + (3, 4))
         assert shape == tuple(-(-n // 2 ** i) for n in grid.shape_zyx)
         assert np.allclose(levels[i], expected, rtol=0, atol=1e-6 * np.abs(expected).max()), i
         assert levels[i][..., 0].sum() == pytest.approx(data[..., 0].astype(np.float64).sum(), abs=1e-4)
@@ -78,7 +79,7 @@ def test_downsampling_sums_children_exactly(engine):
 
 def test_downsampling_conserves_the_injected_flux_in_a_scene(engine):
     """Inside the closed sphere at 32³, 4 levels: Σ c0·2√π is the same on every level (float32: 1e-5)."""
-    engine.render(_sphere_scene(), RenderSettings("lpv", 32, 24, lpv=lpv.LpvSettings(resolution=32, octree_levels=4)))
+    engine.render(_sphere_scene(), RenderSettings("lpv", 32, 24, lpv=LpvSettings(resolution=32, octree_levels=4)))
     fluxes = _entry(engine, "lpv_downsample", lpv_octree.level_fluxes)
     print("flux per level:", fluxes)
     assert fluxes[0] > 0
@@ -89,7 +90,7 @@ def test_index_volume_is_fine_at_geometry_and_coarse_in_empty_space(engine):
     """Open floor at 16³, 3 levels: I(x) = 0 in every cell holding a surface (the merge shader's Eq. 1, read back),
     the CPU hierarchy flattens to the same volume, and cells well above the floor (≥ 8 cells: beyond a level-2 node's
     neighbourhood) use the coarsest level, 2."""
-    engine.render(_floor_scene(), RenderSettings("lpv", 32, 24, lpv=lpv.LpvSettings(resolution=16, octree_levels=3)))
+    engine.render(_floor_scene(), RenderSettings("lpv", 32, 24, lpv=LpvSettings(resolution=16, octree_levels=3)))
 
     def read(merged):
         return np.frombuffer(merged.index.read(), np.float32).reshape(merged.grid.shape_zyx), merged.grid
@@ -114,7 +115,7 @@ def test_index_volume_is_fine_at_geometry_and_coarse_in_empty_space(engine):
 def test_merge_copies_o0_where_the_index_is_0_and_scales_coarse_levels(engine):
     """M(x) = A_0(x) where I(x) = 0 (exactly: a copy), A_i(x >> i)/4^i elsewhere (float32 scaling by a power of 2:
     exact too). Sphere at 16³, 3 levels."""
-    engine.render(_sphere_scene(), RenderSettings("lpv", 32, 24, lpv=lpv.LpvSettings(resolution=16, octree_levels=3)))
+    engine.render(_sphere_scene(), RenderSettings("lpv", 32, 24, lpv=LpvSettings(resolution=16, octree_levels=3)))
     merged, index = _entry(engine, "lpv_merge", lambda m: (
         lpv_octree.read_volumes(m.accum, m.grid),
         np.frombuffer(m.index.read(), np.float32).reshape(m.grid.shape_zyx).astype(int)))
@@ -133,9 +134,9 @@ def test_one_level_equals_the_uniform_lpv(engine):
     same k steps, one bounce and the intensity lookup: the same shaders on the same data, so equal to float32
     rounding (1e-6 relative)."""
     scene = _sphere_scene()
-    a = engine.render(scene, RenderSettings("lpv", 48, 36, lpv=lpv.LpvSettings(
+    a = engine.render(scene, RenderSettings("lpv", 48, 36, lpv=LpvSettings(
         resolution=16, octree_levels=1, octree_iterations=6)))
-    b = engine.render(scene, RenderSettings("lpv", 48, 36, lpv=lpv.LpvSettings(
+    b = engine.render(scene, RenderSettings("lpv", 48, 36, lpv=LpvSettings(
         resolution=16, lookup="intensity", bounces=1, max_iterations=6, epsilon=0.0)))
     da, db = a.passes["Diffuse Indirect"], b.passes["Diffuse Indirect"]
     assert db.max() > 0
@@ -155,7 +156,7 @@ def test_octree_light_level_against_many_uniform_iterations(engine):
     for name, kw in (("uniform64", dict(lookup="intensity", bounces=1, max_iterations=64, epsilon=0.0)),
                      ("uniform4", dict(lookup="intensity", bounces=1, max_iterations=4, epsilon=0.0)),
                      ("octree", dict(octree_levels=3, octree_iterations=4))):
-        r = engine.render(scene, RenderSettings("lpv", 64, 48, lpv=lpv.LpvSettings(resolution=32, **kw)))
+        r = engine.render(scene, RenderSettings("lpv", 64, 48, lpv=LpvSettings(resolution=32, **kw)))
         means[name] = float(r.passes["Diffuse Indirect"][..., 0].mean() * math.pi / e1)
     print("mean E/E1:", {k: round(v, 3) for k, v in means.items()})
     ratio = means["octree"] / means["uniform64"]
@@ -166,7 +167,7 @@ def test_octree_light_level_against_many_uniform_iterations(engine):
 def test_octree_error_metric_is_zero_before_propagation_and_grows(engine):
     """Seed 002 §4.1: right after downsampling every O_i equals Ô_i (the downsampled O_{i-1}), in merge units — so
     e_abs = 0 (float32: 1e-6 of the largest coefficient) — and propagation makes the levels diverge (e_abs > 0)."""
-    settings = lpv.LpvSettings(resolution=16, octree_levels=3)
+    settings = LpvSettings(resolution=16, octree_levels=3)
     engine.render(_sphere_scene(), RenderSettings("lpv", 32, 24, lpv=settings))
 
     def run(ctx):

@@ -4,7 +4,7 @@ import math
 import numpy as np
 import pytest
 
-from bounce_gi.gpu_kernels import metrics
+from bounce_gi.gpu_kernels.output import metrics
 
 # Two pixels, RGB. |x − r| = (1, 0, 0 | 0, 0, 3); Σ|r| = 21.
 REF = np.array([[[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]]])

@@ -6,8 +6,8 @@ import time
 import numpy as np
 import pytest
 
-from bounce_gi.gpu_kernels.light_buffers import ShadowSettings
-from bounce_gi.gpu_kernels.pass_cache import PassCache
+from bounce_gi.gpu_kernels.common.lights import ShadowSettings
+from bounce_gi.gpu_kernels.gl.pass_cache import PassCache
 from bounce_gi.gpu_kernels.scene import Camera, Light, Material, Scene
 
 
@@ -172,7 +172,7 @@ def make_scene(light, cam):
 @pytest.fixture(scope="module")
 def engine():
     from bounce_gi.gpu_kernels.engine import Engine
-    from bounce_gi.gpu_kernels.gpu_context import GpuUnavailableError
+    from bounce_gi.gpu_kernels.gl.context import GpuUnavailableError
 
     eng = Engine()
     try:
@@ -188,7 +188,7 @@ def engine():
 
 @pytest.fixture(scope="module")
 def settings():
-    from bounce_gi.gpu_kernels.pipeline import RenderSettings
+    from bounce_gi.gpu_kernels.settings import RenderSettings
 
     return RenderSettings(method="none", width=160, height=120,
                           shadow=ShadowSettings(sun_resolution=512, spot_resolution=256, cube_resolution=128,

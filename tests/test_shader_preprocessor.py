@@ -3,8 +3,8 @@ from pathlib import Path
 
 import pytest
 
-from gpu_kernels import shader_preprocessor as sp
-from gpu_kernels.shader_preprocessor import GENERATED, ShaderIncludeError
+from gpu_kernels.gl import preprocessor as sp
+from gpu_kernels.gl.preprocessor import GENERATED, ShaderIncludeError
 
 
 def write(root: Path, rel: str, text: str) -> Path:
@@ -278,4 +278,4 @@ def test_load_program_without_stage_blocks(tmp_path, monkeypatch):
 
 
 def test_default_shader_dir():
-    assert sp.SHADER_DIR == Path(sp.__file__).parent / "shaders"
+    assert sp.SHADER_DIR == Path(sp.__file__).parent.parent / "shaders"

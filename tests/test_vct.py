@@ -16,12 +16,14 @@ import math
 import numpy as np
 import pytest
 
-from bounce_gi.gpu_kernels import camera as cam
-from bounce_gi.gpu_kernels import vct
+from bounce_gi.gpu_kernels.common import camera as cam
+from bounce_gi.gpu_kernels.vct.cones import cone_table
+from bounce_gi.gpu_kernels.vct.trace import read_ao, read_level
+from bounce_gi.gpu_kernels.vct.volumes import level_sizes, mip_levels, vct_grid
 from bounce_gi.gpu_kernels.engine import Engine
-from bounce_gi.gpu_kernels.pipeline import RenderSettings
+from bounce_gi.gpu_kernels.settings import RenderSettings
 from bounce_gi.gpu_kernels.scene import Light, Material
-from bounce_gi.gpu_kernels.vct import VctSettings
+from bounce_gi.gpu_kernels.vct.settings import VctSettings
 from support.synthetic import box_quads, lit_patch_error, lit_patch_scene, quad, quad_scene
 
 
@@ -62,7 +64,7 @@ def test_white_furnace_converges_to_the_geometric_series(engine, furnace, anisot
         assert direct == pytest.approx(LE, rel=0.01)
         if anisotropic:
             # Coarse texels at the box's edges are half outside the box, so their mean coverage lets part of a cone
-            # through to the black world (vct_mipmap.glsl): measured 2.1%, 3.2%, 3.9% low for N = 1, 2, 3 at 32³
+            # through to the black world (vct/mipmap.glsl): measured 2.1%, 3.2%, 3.9% low for N = 1, 2, 3 at 32³
             # (2.4%, 3.4%, 4.1% with the volumetric per-pixel march before sub-rays; 5.8%, 7.0%, 7.7% before
             # cone_step's layer test, when the wall beside a cone's start absorbed part of it through the filter).
             assert 0.93 * expected < indirect < 1.01 * expected
@@ -135,7 +137,7 @@ def test_lit_floor_lights_the_wall_and_nothing_lights_the_floor(engine):
     ours = di[ys[pick], xs[pick]]
     print("wall Diffuse Indirect, ours vs view factor:", np.round(ours, 3), np.round(exact, 3),
           f"mean ratio {ours.mean() / exact.mean():.3f}")
-    # The cones see the floor through 7 sub-rays each (vct_crossing.glsl), so single pixels can be off by a sub-ray
+    # The cones see the floor through 7 sub-rays each (vct/crossing.glsl), so single pixels can be off by a sub-ray
     # at the floor's edges; the mean over the wall is measured 0.956 of the view factor with the default 9 cones
     # (32³; 1.05 with 19 cones and the volumetric march before sub-rays). Bound: within 10%.
     assert ours.mean() == pytest.approx(exact.mean(), rel=0.10)
@@ -147,7 +149,7 @@ def test_lit_floor_lights_the_wall_and_nothing_lights_the_floor(engine):
 @pytest.mark.parametrize("receiver", ["plate above", "wall beside"])
 def test_a_lit_patch_in_a_dark_floor_matches_its_view_factor(engine, receiver):
     """A 3 × 2.5 m lit patch in a black 6 × 6 m floor, seen from a plate 3 m above it and from a wall 1.5 m beside
-    it (the courtyard's case: bounced light from a sunlit patch). Before the per-pixel sub-rays (vct_crossing.glsl)
+    it (the courtyard's case: bounced light from a sunlit patch). Before the per-pixel sub-rays (vct/crossing.glsl)
     the cones read the patch at their own coarse level, which spread its light over neighbouring cones, and skimmed
     the floor without meeting it: the plate came out 1.61× and the wall 1.51× the exact integral (64³, 19 cones).
     Measured since: plate 0.963 (per-sample rel-L1 0.059), wall 1.008 (0.083). Bounds: mean within 10%, rel-L1
@@ -168,7 +170,7 @@ def _volumes(engine, scene, anisotropic):
 
     def grab(ctx):
         vols = pipe.cache.entries["vct_mipmap"].value
-        return vols.grid, [[vct.read_level(ctx, pipe.programs, t, vols.grid, level) for level in range(vols.levels)]
+        return vols.grid, [[read_level(ctx, pipe.programs, t, vols.grid, level) for level in range(vols.levels)]
                            for t in vols.textures]
     return engine.worker.call(grab)
 
@@ -248,8 +250,8 @@ def test_a_sunlit_roof_top_does_not_light_the_room_below(engine):
     and a floor patch. The roof's top cannot be seen from inside, so after one bounce the walls' Diffuse Indirect
     must not depend on the roof's albedo (the underside is unlit, hence black, either way). Coarse texels straddling
     the roof used to show its lit top to cones passing under it: the upper walls came out 1.28× as bright with a
-    white roof as with a black one before the layer test of cone_step (vct_common.glsl); measured 1.000 since, and
-    with the per-pixel sub-rays (vct_crossing.glsl: a sub-ray under the roof never crosses it). Bound 2%, for float
+    white roof as with a black one before the layer test of cone_step (vct/common.glsl); measured 1.000 since, and
+    with the per-pixel sub-rays (vct/crossing.glsl: a sub-ray under the roof never crosses it). Bound 2%, for float
     rounding across drivers."""
     walls = box_quads((-1.5, -1.5, 0), (1.5, 1.5, 2), 0, skip=((2, "hi"),))
     roof = [(quad([(a, c, 2), (b, c, 2), (b, d, 2), (a, d, 2)], (0, 0, -1)), 1)
@@ -275,7 +277,7 @@ def test_passes_rerun_only_downstream_and_ao_is_sky_visibility(engine, furnace):
     floor = quad([(-2, -2, 0), (2, -2, 0), (2, 2, 0), (-2, 2, 0)], (0, 0, 1))
     scene = quad_scene([(floor, 0)], [Material("white", (0.8, 0.8, 0.8))], [sun], (0, -3, 2), (0, 0, 0), lens=20.0)
     r = _render(engine, scene, bounces=1)
-    assert r.info["grid"] == [32, 32, 8] and r.info["levels"] == vct.mip_levels(32) and r.info["anisotropic"]
+    assert r.info["grid"] == [32, 32, 8] and r.info["levels"] == mip_levels(32) and r.info["anisotropic"]
     assert r.info["occupied_voxels"] > 0 and len(r.info["bounces"]) == 1
     r = _render(engine, scene, bounces=2)
     assert {"vct_voxelize", "vct_inject", "vct_mipmap"} <= set(r.skipped)
@@ -284,11 +286,11 @@ def test_passes_rerun_only_downstream_and_ao_is_sky_visibility(engine, furnace):
     # A lone floor under a black sky: every cone leaves the grid, so AO (sky visibility) is 1 and nothing lights
     # the floor indirectly; a closed box: no cone should leave, AO should be 0.
     pipe = engine._pipeline
-    ao = engine.worker.call(lambda ctx: vct.read_ao(pipe.cache.entries["vct_trace"].value["indirect"]))
+    ao = engine.worker.call(lambda ctx: read_ao(pipe.cache.entries["vct_trace"].value["indirect"]))
     hit = r.passes["Depth"][..., 0] < 1e9
     assert float(ao[hit].min()) > 0.999 and float(r.passes["Diffuse Indirect"][hit].max()) < 1e-6
     r = _render(engine, furnace)
-    ao = engine.worker.call(lambda ctx: vct.read_ao(pipe.cache.entries["vct_trace"].value["indirect"]))
+    ao = engine.worker.call(lambda ctx: read_ao(pipe.cache.entries["vct_trace"].value["indirect"]))
     hit = r.passes["Depth"][..., 0] < 1e9
     # The furnace loses 5% of its light through coarse texels at the box's edges (see above), so AO is not 0 there:
     # measured mean 0.04, max 0.13; bounds 0.08 and 0.2.
@@ -337,7 +339,7 @@ def test_defaults_are_valid_and_keys_separate_passes():
 
 @pytest.mark.parametrize("count", [5, 6, 7, 8, 9, 13, 16, 19, 25, 31])
 def test_cone_weights_integrate_the_cosine_exactly(count):
-    dirs, weights, tans = vct.cone_table(count)
+    dirs, weights, tans = cone_table(count)
     assert len(dirs) == len(weights) == count and np.allclose(np.linalg.norm(dirs, axis=1), 1.0)
     assert weights.sum() == pytest.approx(math.pi, rel=1e-12)  # uniform radiance L → E = π·L exactly
     # Independently of cone_table's closed forms: the regions are a cap and rings of equal solid angle 2π/n, cut
@@ -366,7 +368,7 @@ def test_cone_weights_integrate_the_cosine_exactly(count):
 
 
 def test_second_ring_is_turned_half_a_sector():
-    dirs, _, _ = vct.cone_table(19)
+    dirs, _, _ = cone_table(19)
     phi1 = np.degrees(np.arctan2(dirs[1:7, 1], dirs[1:7, 0])) % 360
     phi2 = np.degrees(np.arctan2(dirs[7:, 1], dirs[7:, 0])) % 360
     assert np.allclose(np.sort(phi1), np.arange(6) * 60.0) and np.allclose(np.sort(phi2), 15.0 + np.arange(12) * 30.0)
@@ -375,7 +377,7 @@ def test_second_ring_is_turned_half_a_sector():
 def test_grid_is_padded_so_mip_levels_nest():
     scene = quad_scene(box_quads((0, 0, 0), (3.0, 2.0, 0.4), 0), [Material("m")], [], (1, -3, 1), (1, 1, 0.2))
     s = VctSettings(resolution=64)
-    grid = vct.vct_grid(scene, s)
-    align = 2 ** (vct.mip_levels(64) - 1)
+    grid = vct_grid(scene, s)
+    align = 2 ** (mip_levels(64) - 1)
     assert all(n % align == 0 for n in grid.size) and max(grid.size) == 64
-    assert vct.level_sizes(grid, vct.mip_levels(64))[-1] == tuple(n // align for n in grid.size)
+    assert level_sizes(grid, mip_levels(64))[-1] == tuple(n // align for n in grid.size)

@@ -9,11 +9,12 @@ import math
 import numpy as np
 import pytest
 
-from bounce_gi.gpu_kernels import vct_specular
+from bounce_gi.gpu_kernels.vct import specular as vct_specular
 from bounce_gi.gpu_kernels.engine import Engine
-from bounce_gi.gpu_kernels.pipeline import PASS_NAMES, RenderSettings
+from bounce_gi.gpu_kernels.compose import PASS_NAMES
+from bounce_gi.gpu_kernels.settings import RenderSettings
 from bounce_gi.gpu_kernels.scene import Light, Material
-from bounce_gi.gpu_kernels.vct import VctSettings
+from bounce_gi.gpu_kernels.vct.settings import VctSettings
 from support.synthetic import quad, quad_scene
 
 SUN, WALL_RHO, WALL_TOP = 4.0, 0.8, 1.2
@@ -72,7 +73,7 @@ def test_mirror_floor_reflects_the_lit_wall(engine):
     # Rays leaving over the wall see the black world: nothing (a cone brushing the wall's top texels keeps < 2%).
     assert float(gi[over].max()) < 0.02 * L_WALL
     # The floor's own diffuse light: none (sun grazing, the wall's light is Diffuse Indirect, not Glossy).
-    # Glossy Color: the dielectric layer's albedo 1 − diffuse share (gbuffer.glsl), so DiffCol + 0.8·GlossCol = 0.8.
+    # Glossy Color: the dielectric layer's albedo 1 − diffuse share (direct/gbuffer.glsl), so DiffCol + 0.8·GlossCol = 0.8.
     hit = r.passes["Depth"][..., 0] < 1e9
     floor = hit & (np.abs(r.passes["Position"][..., 2]) < 1e-4)
     gc, dc = r.passes["Glossy Color"][floor], r.passes["Diffuse Color"][floor]

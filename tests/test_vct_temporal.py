@@ -6,10 +6,10 @@ import dataclasses
 import numpy as np
 import pytest
 
-from bounce_gi.gpu_kernels import vct_temporal
+from bounce_gi.gpu_kernels.vct import temporal as vct_temporal
 from bounce_gi.gpu_kernels.engine import Engine
-from bounce_gi.gpu_kernels.pipeline import RenderSettings
-from bounce_gi.gpu_kernels.vct import VctSettings
+from bounce_gi.gpu_kernels.settings import RenderSettings
+from bounce_gi.gpu_kernels.vct.settings import VctSettings
 from test_vct import _sunlit_room
 
 N = 8

@@ -1,6 +1,6 @@
 """Reduced-resolution VCT gather and its discontinuity-aware upsampling (seed 003, inferred lighting).
 
-The upsampler (vct_upsample.glsl) is driven directly with fields we choose, on G-buffers rendered from an orthographic
+The upsampler (vct/upsample.glsl) is driven directly with fields we choose, on G-buffers rendered from an orthographic
 camera looking straight down, where world position is affine in the pixel coordinates, so bilinear interpolation of
 a field affine in position is exact:
   (a) constant and affine fields come back exactly (float32 rounding);
@@ -11,12 +11,12 @@ then (c) the whole pipeline at indirect_scale 2 and 4 stays close to scale 1.
 import numpy as np
 import pytest
 
-from bounce_gi.gpu_kernels import camera as cam
-from bounce_gi.gpu_kernels import vct_upsample
+from bounce_gi.gpu_kernels.common import camera as cam
+from bounce_gi.gpu_kernels.vct import upsample as vct_upsample
 from bounce_gi.gpu_kernels.engine import Engine
-from bounce_gi.gpu_kernels.pipeline import RenderSettings
+from bounce_gi.gpu_kernels.settings import RenderSettings
 from bounce_gi.gpu_kernels.scene import Camera, Material
-from bounce_gi.gpu_kernels.vct import VctSettings
+from bounce_gi.gpu_kernels.vct.settings import VctSettings
 from support.synthetic import quad, quad_scene
 from test_vct import _sunlit_room
 

@@ -10,7 +10,7 @@ both (0.117 / 0.060), the spot room both (0.094 / 0.035), the courtyard Diffuse 
 one that makes it better should lower these bounds. History (Diffuse Indirect / Combined, against 128 spp): 9 → 19
 diffuse cones (Cornell 0.185 / 0.092 → 0.164 / 0.081, courtyard 0.260 / 0.180 → 0.278 / 0.192), cone_step's layer
 test (Cornell 0.153 / 0.076, spot room 0.147 / 0.054, courtyard 0.219 / 0.152), then the per-pixel sub-rays
-(vct_crossing.glsl) with 9 cones (the numbers above). The single bounce is further from full-bounce Cycles than
+(vct/crossing.glsl) with 9 cones (the numbers above). The single bounce is further from full-bounce Cycles than
 before the sub-rays (Cornell 0.428 → 0.479): its one-bounce light used to be too bright by 9–21%, which hid part of
 the missing bounces; against one-bounce Cycles (2048 spp) it improved, Cornell 0.158 → 0.100, courtyard 0.439 → 0.113.
 """

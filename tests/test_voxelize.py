@@ -3,10 +3,10 @@ determinism, fixed-point overflow handling and lattice snapping. Runs on Mesa ll
 import numpy as np
 import pytest
 
-from bounce_gi.gpu_kernels import direct
-from bounce_gi.gpu_kernels import voxelize as vz
-from bounce_gi.gpu_kernels.grid import Grid
-from bounce_gi.gpu_kernels.programs import ProgramCache
+from bounce_gi.gpu_kernels.direct import geometry as direct
+from bounce_gi.gpu_kernels.voxel import voxelize as vz
+from bounce_gi.gpu_kernels.common.grid import Grid
+from bounce_gi.gpu_kernels.gl.programs import ProgramCache
 from bounce_gi.gpu_kernels.scene import Material, Scene, Texture
 
 trimesh = pytest.importorskip("trimesh")
@@ -234,7 +234,7 @@ def test_raster_areas_are_exact_per_voxel(gl):
     """Random triangles (some leaving the grid) against a float64 CPU clipper: every voxel's area and its three
     projected areas. Tolerance 1e-5 cell² per voxel: float32 pixel coordinates (~1e-6 cell) times the few
     pieces per voxel, plus < 2^-18 = 3.8e-6 cell² per sliver piece from the minimum-count rule
-    (voxelize_common.glsl); a wrong clip, slab or axis mapping errs by a sizeable fraction of a cell²."""
+    (voxel/common.glsl); a wrong clip, slab or axis mapping errs by a sizeable fraction of a cell²."""
     rng = np.random.default_rng(7)
     centres = rng.uniform(-0.5, 8.5, (40, 1, 3))
     tris = centres + rng.normal(0.0, 1.5, (40, 3, 3))

@@ -85,8 +85,8 @@ def _unexpected(ex: BaseException, during: str) -> PreviewError:
 
 def _user_facing_errors() -> tuple:
     """Engine exceptions whose message is written for the user (reported as is, no traceback)."""
-    from ..gpu_kernels.gpu_context import GpuUnavailableError
-    from ..gpu_kernels.pipeline import SceneError
+    from ..gpu_kernels.gl.context import GpuUnavailableError
+    from ..gpu_kernels.settings import SceneError
 
     return (SceneError, GpuUnavailableError)
 
@@ -107,7 +107,7 @@ def start_render(scene, depsgraph) -> PendingRender:
     try:
         from ..addon.extract import ExtractError, extract_scene
         from ..gpu_kernels.engine import get_engine
-        from ..gpu_kernels.pipeline import RenderSettings
+        from ..gpu_kernels.settings import RenderSettings
     except ImportError as ex:
         raise PreviewError(f"Bounce GI engine unavailable: {one_line(ex)}") from None
 

@@ -3,7 +3,7 @@ import math
 
 import numpy as np
 
-from bounce_gi.gpu_kernels import camera as cam
+from bounce_gi.gpu_kernels.common import camera as cam
 from bounce_gi.gpu_kernels.scene import Camera, Light, Material, Scene, World
 
 

@@ -1,0 +1,318 @@
+"""Lights → GPU records, and the shadow views every light needs (pure numpy; no GL here).
+
+Units follow Cycles (design.md §3; intern/cycles/scene/light.cpp):
+- sun: `power` is irradiance at normal incidence (W/m²);
+- point/spot: radiant intensity P/(4π) W/sr; a spot is a point light masked by its cone, not concentrated into it;
+- area: one-sided Lambertian emitter of radiance P/(π·A) over its area A;
+- emissive triangles: radiance = material emission (colour × strength), emitted from both sides as in Cycles.
+Area lights and emissive triangles are "polygon lights", integrated exactly (Lambert's formula) in the shader,
+shadowed by a few sample points on the light, each with a six-view shadow cube (the documented approximation).
+
+Every numpy dtype here mirrors a GLSL struct in shaders/lights_common.glsl field for field (std430).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import camera as cam
+from ..scene import Light, Scene
+
+LIGHT_SUN, LIGHT_POINT, LIGHT_SPOT, LIGHT_POLYGON = 0, 1, 2, 3
+
+LIGHT_DTYPE = np.dtype([("color_type", "<f4", 4), ("position", "<f4", 4), ("direction", "<f4", 4),
+                        ("params", "<f4", 4), ("polygon", "<f4", 4)])
+VIEW_DTYPE = np.dtype([("view_projection", "<f4", (4, 4)), ("tile", "<f4", 4), ("origin", "<f4", 4),
+                       ("info", "<f4", 4)])
+DISK_SEGMENTS = 32
+CUBE_DIRECTIONS = [(np.array(f), np.array(u)) for f, u in (
+    ((1, 0, 0), (0, -1, 0)), ((-1, 0, 0), (0, -1, 0)), ((0, 1, 0), (0, 0, 1)),
+    ((0, -1, 0), (0, 0, -1)), ((0, 0, 1), (0, -1, 0)), ((0, 0, -1), (0, -1, 0)))]
+
+
+@dataclass
+class ShadowSettings:
+    sun_resolution: int = 2048
+    spot_resolution: int = 1024
+    cube_resolution: int = 512  # per face, point lights
+    sample_cube_resolution: int = 256  # per face, area/emissive sample points
+    area_samples: int = 2  # n×n shadow sample points on square/rectangle lights (n² ring points on disks)
+    max_shadowed_emissive: int = 16  # emissive triangles beyond this light unshadowed (a warning says so)
+    emissive_sample_budget: int = 64  # shadow cubes for all emissive triangles together
+    pcf_radius: int = 1  # PCF kernel (2r+1)²
+
+
+@dataclass
+class ShadowView:
+    view_projection: np.ndarray  # (4, 4) float64, world → clip
+    origin: np.ndarray  # eye (perspective) or a point on the sun's near plane
+    ortho: bool
+    texel_world: float  # world size of one texel at unit distance (perspective) or absolute (ortho)
+    resolution: int
+    far: float = 0.0  # perspective: depth is stored as distance / far; 0 for orthographic
+    view_matrix: np.ndarray | None = None  # world → view (rows: right, up, −forward)
+    half_extent: float = 0.0  # tan(half fov) (perspective) or half width in metres (orthographic)
+
+
+@dataclass
+class LightBuffers:
+    lights: np.ndarray  # LIGHT_DTYPE records
+    views: list  # ShadowView, in the order lights refer to them
+    polygon_vertices: np.ndarray  # (V, 4) float32
+    warnings: list
+    view_lights: list = None  # index of the light record each view belongs to
+
+
+def _color(light: Light) -> np.ndarray:
+    # Cycles ignores the EEVEE-only diffuse_factor/specular_factor, so do we.
+    return np.asarray(light.color, np.float64)[:3]
+
+
+def _falloff_radius2(light: Light) -> float:
+    """r² added to d² in the point-light law: Cycles' soft-falloff light is a disk of radius r facing the
+    receiver, whose irradiance is P/(4π)·cosθ/(d²+r²) (kernel/light/point.h); a sphere light (soft falloff off)
+    gives exactly the point law outside the sphere."""
+    return light.radius ** 2 if light.soft_falloff else 0.0
+
+
+def area_polygon(light: Light) -> tuple[np.ndarray, float]:
+    """World-space polygon of an area light and its true area. Disks/ellipses become a 32-gon of equal area."""
+    m = np.asarray(light.matrix_world, np.float64)
+    sx = light.size
+    sy = light.size if light.shape in ("SQUARE", "DISK") else light.size_y
+    if light.shape in ("SQUARE", "RECTANGLE"):
+        local = np.array([[-sx / 2, -sy / 2], [sx / 2, -sy / 2], [sx / 2, sy / 2], [-sx / 2, sy / 2]])
+        area = sx * sy
+    else:
+        n = DISK_SEGMENTS
+        # Scale the n-gon so its area equals the ellipse's π·a·b (the inscribed n-gon is smaller by sin(2π/n)·n/2π).
+        k = math.sqrt(2 * math.pi / (n * math.sin(2 * math.pi / n)))
+        t = np.arange(n) * 2 * math.pi / n
+        local = np.stack([np.cos(t) * sx / 2 * k, np.sin(t) * sy / 2 * k], axis=1)
+        area = math.pi * sx * sy / 4
+    pts = np.concatenate([local, np.zeros((len(local), 1)), np.ones((len(local), 1))], axis=1) @ m.T
+    # The matrix may scale the light (Blender scales area lights by the object scale).
+    sx_w, sy_w = np.linalg.norm(m[:3, 0]), np.linalg.norm(m[:3, 1])
+    return pts[:, :3], area * sx_w * sy_w
+
+
+def area_sample_points(light: Light, n: int) -> np.ndarray:
+    """n×n stratified points on a rectangle (cell centres), or n² points on rings of a disk, in world space."""
+    m = np.asarray(light.matrix_world, np.float64)
+    sx = light.size
+    sy = light.size if light.shape in ("SQUARE", "DISK") else light.size_y
+    if light.shape in ("SQUARE", "RECTANGLE"):
+        g = (np.arange(n) + 0.5) / n - 0.5
+        u, v = np.meshgrid(g * sx, g * sy)
+        local = np.stack([u.ravel(), v.ravel()], axis=1)
+    else:
+        count = n * n
+        if count == 1:
+            local = np.zeros((1, 2))
+        else:  # equal-area points: radius sqrt((i+0.5)/count), golden-angle spiral
+            i = np.arange(count)
+            r = np.sqrt((i + 0.5) / count)
+            t = i * math.pi * (3 - math.sqrt(5))
+            local = np.stack([r * np.cos(t) * sx / 2, r * np.sin(t) * sy / 2], axis=1)
+    pts = np.concatenate([local, np.zeros((len(local), 1)), np.ones((len(local), 1))], axis=1) @ m.T
+    return pts[:, :3]
+
+
+def triangle_sample_points(tri: np.ndarray, count: int) -> np.ndarray:
+    """1 point (the centroid) or 4 (centroids of the four midpoint sub-triangles) on a triangle."""
+    if count == 1:
+        return tri.mean(axis=0, keepdims=True)
+    a, b, c = tri
+    ab, bc, ca = (a + b) / 2, (b + c) / 2, (c + a) / 2
+    return np.array([(a + ab + ca) / 3, (ab + b + bc) / 3, (ca + bc + c) / 3, (ab + bc + ca) / 3])
+
+
+def _scene_radius(scene: Scene) -> tuple[np.ndarray, float]:
+    lo, hi = scene.bounds()
+    return (lo + hi) / 2, max(float(np.linalg.norm(hi - lo)) / 2, 1e-3)
+
+
+def cube_views(origin, resolution: int, near: float, far: float) -> list[ShadowView]:
+    """Six perspective views around `origin`, each a little wider than 90° so PCF never reads past a face edge."""
+    margin = 1.0 + 4.0 * 2 / resolution  # two texels of margin on each side
+    fov = 2 * math.atan(margin)
+    proj = cam.perspective(fov, 1.0, near, far)
+    views = []
+    for fwd, up in CUBE_DIRECTIONS:
+        view = cam.look_at(origin, np.asarray(origin) + fwd, up)
+        views.append(ShadowView(proj @ view, np.asarray(origin, np.float64), False,
+                                2 * margin / resolution, resolution, far, view, margin))
+    return views
+
+
+def sun_view(scene: Scene, light: Light, resolution: int) -> ShadowView:
+    """Orthographic view along the sun direction, fitted to the scene's bounding sphere."""
+    centre, radius = _scene_radius(scene)
+    d = light.direction
+    eye = centre - d * radius * 2
+    up = np.array([0, 0, 1.0]) if abs(d[2]) < 0.99 else np.array([0, 1.0, 0])
+    view = cam.look_at(eye, centre, up)
+    r = radius * 1.02
+    proj = cam.ortho(-r, r, -r, r, radius * 0.5, radius * 3.5)
+    return ShadowView(proj @ view, eye, True, 2 * r / resolution, resolution, 0.0, view, r)
+
+
+def spot_view(scene: Scene, light: Light, resolution: int, near: float, far: float) -> ShadowView:
+    fov = min(light.spot_size * 1.05 + 4 * 2 / resolution, math.radians(170))
+    pos = light.position
+    d = light.direction
+    up = np.array([0, 0, 1.0]) if abs(d[2]) < 0.99 else np.array([0, 1.0, 0])
+    view = cam.look_at(pos, pos + d, up)
+    return ShadowView(cam.perspective(fov, 1.0, near, far) @ view, pos, False,
+                      2 * math.tan(fov / 2) / resolution, resolution, far, view, math.tan(fov / 2))
+
+
+def _near_far(scene: Scene, origin) -> tuple[float, float]:
+    centre, radius = _scene_radius(scene)
+    far = float(np.linalg.norm(np.asarray(origin) - centre)) + radius * 1.01
+    return max(far * 1e-4, 1e-3), max(far, 1e-2)
+
+
+def emissive_triangles(scene: Scene) -> tuple[np.ndarray, np.ndarray]:
+    """Indices of triangles whose material emits, and their emitted radiance (RGB), brightest power first."""
+    if scene.triangle_count == 0 or not scene.materials:
+        return np.zeros(0, np.int64), np.zeros((0, 3))
+    emission = np.array([m.emission for m in scene.materials], np.float64).reshape(-1, 3)
+    idx = np.nonzero(emission[scene.material_index].max(axis=1) > 0)[0]
+    if len(idx) == 0:
+        return idx, np.zeros((0, 3))
+    p = scene.positions[idx].astype(np.float64)
+    area = 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
+    radiance = emission[scene.material_index[idx]]
+    order = np.argsort(-(radiance.sum(axis=1) * area), kind="stable")
+    keep = area[order] > 0
+    return idx[order][keep], radiance[order][keep]
+
+
+def build_light_buffers(scene: Scene, settings: ShadowSettings | None = None) -> LightBuffers:
+    """Pack every light (and emissive triangle) into GPU records and list the shadow views they sample."""
+    s = settings or ShadowSettings()
+    records, views, polys, warnings, view_lights = [], [], [], [], []
+
+    def add(type_, color, position=(0, 0, 0), radius=0.0, direction=(0, 0, -1), cos_half=0.0, smooth=0.0,
+            light_views=(), samples=0, per=0, poly=None, two_sided=False):
+        rec = np.zeros((), LIGHT_DTYPE)
+        rec["color_type"] = (*color, type_)
+        rec["position"] = (*position, radius)
+        rec["direction"] = (*direction, cos_half)
+        rec["params"] = (smooth, len(views), samples, per)
+        if poly is not None:
+            rec["polygon"] = (sum(len(p) for p in polys), len(poly), 1.0 if two_sided else 0.0, 0)
+            polys.append(np.asarray(poly, np.float64))
+        views.extend(light_views)
+        view_lights.extend([len(records)] * len(light_views))
+        records.append(rec)
+
+    for light in scene.lights:
+        color = _color(light)
+        if light.type == "SUN":
+            v = [sun_view(scene, light, s.sun_resolution)] if light.cast_shadow else []
+            add(LIGHT_SUN, color * light.power, direction=light.direction, light_views=v, samples=len(v), per=1)
+        elif light.type in ("POINT", "SPOT"):
+            intensity = color * light.power / (4 * math.pi)
+            near, far = _near_far(scene, light.position)
+            if light.type == "POINT":
+                v = cube_views(light.position, s.cube_resolution, near, far) if light.cast_shadow else []
+                add(LIGHT_POINT, intensity, light.position, _falloff_radius2(light), light_views=v,
+                    samples=1 if v else 0, per=6)
+            else:
+                cos_half = math.cos(light.spot_size / 2)
+                smooth = 1.0 / ((1.0 - cos_half) * light.spot_blend) if light.spot_blend > 0 and cos_half < 1 else 0.0
+                v = [spot_view(scene, light, s.spot_resolution, near, far)] if light.cast_shadow else []
+                add(LIGHT_SPOT, intensity, light.position, _falloff_radius2(light), light.direction, cos_half, smooth,
+                    light_views=v, samples=1 if v else 0, per=1)
+        elif light.type == "AREA":
+            poly, area = area_polygon(light)
+            if area <= 0:
+                warnings.append(f"area light '{light.name}' has zero size and is ignored")
+                continue
+            radiance = color * light.power / (math.pi * area)
+            v = []
+            pts = area_sample_points(light, s.area_samples) if light.cast_shadow else []
+            for point in pts:
+                v.extend(cube_views(point, s.sample_cube_resolution, *_near_far(scene, point)))
+            add(LIGHT_POLYGON, radiance, poly.mean(axis=0), 0.0, light.direction, light_views=v,
+                samples=len(pts), per=6, poly=poly)
+        else:
+            warnings.append(f"light '{light.name}' of type {light.type} is not supported and is ignored")
+
+    tri_idx, radiance = emissive_triangles(scene)
+    shadowed = min(len(tri_idx), s.max_shadowed_emissive)
+    # Few emitters get 4 shadow points per side (centroids of the midpoint subdivision) for softer, truer
+    # penumbrae; many get one, so the number of shadow cubes stays within the budget.
+    per_side = 4 if shadowed * 2 * 4 <= s.emissive_sample_budget else 1
+    for rank, (t, rad) in enumerate(zip(tri_idx, radiance)):
+        tri = scene.positions[t].astype(np.float64)
+        centroid = tri.mean(axis=0)
+        normal = np.cross(tri[1] - tri[0], tri[2] - tri[0])
+        normal /= np.linalg.norm(normal)
+        v, samples = [], 0
+        if rank < shadowed:
+            # Sample points nudged off the surface so the triangle does not shadow itself; they alternate sides
+            # (even: along the normal, odd: against it) as direct/light.glsl expects of two-sided emitters.
+            eps = 1e-3 * max(float(np.linalg.norm(tri[1] - tri[0])), 1e-3)
+            for point in triangle_sample_points(tri, per_side):
+                for side in (1.0, -1.0):
+                    p = point + side * eps * normal
+                    v.extend(cube_views(p, s.sample_cube_resolution, *_near_far(scene, p)))
+                    samples += 1
+        add(LIGHT_POLYGON, rad, centroid, 0.0, normal, light_views=v, samples=samples, per=6, poly=tri,
+            two_sided=True)
+    if len(tri_idx) > s.max_shadowed_emissive:
+        warnings.append(f"{len(tri_idx) - s.max_shadowed_emissive} of {len(tri_idx)} emissive triangles light "
+                        "the scene without shadows (only the brightest are shadowed)")
+
+    lights = np.array(records, LIGHT_DTYPE) if records else np.zeros(0, LIGHT_DTYPE)
+    vertices = np.concatenate(polys) if polys else np.zeros((0, 3))
+    vertices = np.concatenate([vertices, np.ones((len(vertices), 1))], axis=1).astype(np.float32)
+    return LightBuffers(lights, views, vertices, warnings, view_lights)
+
+
+def pack_views(views: list[ShadowView], tiles: list[tuple], atlas_size: tuple[int, int], pcf_radius: int,
+               view_lights: list | None = None) -> np.ndarray:
+    """ShadowView list + atlas tiles (x, y, w, h in texels) → VIEW_DTYPE records (info.w = the view's light)."""
+    out = np.zeros(len(views), VIEW_DTYPE)
+    aw, ah = atlas_size
+    for i, (v, (x, y, w, h)) in enumerate(zip(views, tiles)):
+        # GLSL mat4 is column-major: store the transpose of the row-major numpy matrix.
+        out[i]["view_projection"] = v.view_projection.T
+        out[i]["tile"] = (x / aw, y / ah, w / aw, h / ah)
+        out[i]["origin"] = (*v.origin, 1.0 if v.ortho else 0.0)
+        # The atlas may have shrunk the tile: a texel then covers resolution/w times more ground.
+        light = view_lights[i] if view_lights is not None else 0
+        out[i]["info"] = (v.texel_world * v.resolution / w, pcf_radius, v.far, light)
+    return out
+
+
+def allocate_atlas(resolutions: list[int], width: int = 4096, max_height: int = 16384):
+    """Shelf-pack square tiles (largest first). Returns (tiles in input order, atlas size, scale applied)."""
+    scale = 1
+    while max(resolutions, default=0) // scale > width:  # a tile must fit the atlas width
+        scale *= 2
+    while True:
+        if scale > 1 << 16:
+            raise ValueError(f"{len(resolutions)} shadow views do not fit a {width}x{max_height} atlas")
+        res = [max(16, r // scale) for r in resolutions]
+        order = sorted(range(len(res)), key=lambda i: -res[i])
+        tiles = [None] * len(res)
+        x = y = shelf = 0
+        side = 1 << max(4, math.ceil(math.log2(math.sqrt(sum(r * r for r in res)) + 1)))
+        atlas_w = min(width, max(max(res, default=16), side))
+        for i in order:
+            r = res[i]
+            if x + r > atlas_w:
+                x, y, shelf = 0, y + shelf, 0
+            tiles[i] = (x, y, r, r)
+            x += r
+            shelf = max(shelf, r)
+        height = max(y + shelf, 16)
+        if height <= max_height:
+            return tiles, (atlas_w, height), scale
+        scale *= 2

@@ -1,0 +1,88 @@
+"""Geometry and material inputs of every raster pass: the interleaved vertex buffer grouped by material, the
+material textures, and drawing one material range at a time with its uniforms (common/materials.glsl)."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..gl.bind import set_uniform
+from ..scene import Scene
+
+
+@dataclass
+class GeometryBuffers:
+    vbo: object
+    vao_full: object  # position, normal, uv, geometric normal
+    vao_depth: object  # position only (shadow maps)
+    ranges: list  # (material index, first vertex, vertex count), triangles grouped by material
+
+    def release(self):
+        for obj in (self.vao_full, self.vao_depth, self.vbo):
+            obj.release()
+
+
+def upload_geometry(ctx, programs, scene: Scene) -> GeometryBuffers:
+    """Interleave corners (position, normal, uv, geometric normal) grouped by material into one VBO."""
+    order = np.argsort(scene.material_index, kind="stable")
+    pos = scene.positions[order].astype(np.float32)
+    nrm = scene.normals[order].astype(np.float32)
+    uvs = scene.uvs[order].astype(np.float32)
+    geo = np.cross(pos[:, 1] - pos[:, 0], pos[:, 2] - pos[:, 0])
+    geo /= np.maximum(np.linalg.norm(geo, axis=1, keepdims=True), 1e-30)
+    geo = np.repeat(geo[:, None, :], 3, axis=1)
+    data = np.concatenate([pos, nrm, uvs, geo], axis=2).astype(np.float32)  # (T, 3, 11)
+    vbo = ctx.buffer(np.ascontiguousarray(data).tobytes() or b"\0" * 44)
+    gbuf = programs.raster("direct/gbuffer.glsl")
+    depth = programs.raster("direct/shadow_depth.glsl")
+    vao_full = ctx.vertex_array(gbuf, [(vbo, "3f 3f 2f 3f", "in_position", "in_normal", "in_uv", "in_geo_normal")])
+    vao_depth = ctx.vertex_array(depth, [(vbo, "3f 32x", "in_position")])
+    mats = scene.material_index[order]
+    ranges = []
+    if len(mats):
+        starts = np.flatnonzero(np.r_[True, mats[1:] != mats[:-1]])
+        ends = np.r_[starts[1:], len(mats)]
+        ranges = [(int(mats[s]), int(s) * 3, int(e - s) * 3) for s, e in zip(starts, ends)]
+    return GeometryBuffers(vbo, vao_full, vao_depth, ranges)
+
+
+def upload_textures(ctx, scene: Scene) -> list:
+    """Material textures as float RGBA, bilinear without mipmaps (Cycles' CPU 'Linear' filtering)."""
+    import moderngl
+
+    out = []
+    for tex in scene.textures:
+        px = np.ascontiguousarray(tex.pixels, np.float32)
+        h, w = px.shape[:2]
+        t = ctx.texture((w, h), 4, px.tobytes(), dtype="f4")
+        f = moderngl.NEAREST if tex.interpolation == "Closest" else moderngl.LINEAR
+        t.filter = (f, f)
+        t.repeat_x = t.repeat_y = tex.extension == "REPEAT"
+        out.append(t)
+    return out
+
+
+def bind_material(prog, scene: Scene, mat_index: int, textures: list) -> None:
+    """Set the material uniforms of common/materials.glsl for one material (unused ones are skipped)."""
+    mat = scene.materials[mat_index] if 0 <= mat_index < len(scene.materials) else None
+    base = mat.base_color if mat else (0.8, 0.8, 0.8)
+    set_uniform(prog, "u_base_color", tuple(float(c) for c in base[:3]))
+    set_uniform(prog, "u_metallic", float(mat.metallic) if mat else 0.0)
+    set_uniform(prog, "u_roughness", float(mat.roughness) if mat else 0.5)
+    set_uniform(prog, "u_specular_layer", bool(mat and mat.specular_layer))
+    set_uniform(prog, "u_emission", tuple(float(c) for c in (mat.emission if mat else (0, 0, 0))[:3]))
+    use_tex = bool(mat and 0 <= mat.base_color_texture < len(textures))
+    set_uniform(prog, "u_use_texture", use_tex)
+    if use_tex:
+        textures[mat.base_color_texture].use(location=0)
+        set_uniform(prog, "u_base_texture", 0)
+
+
+def draw_by_material(prog, scene: Scene, geometry: GeometryBuffers, textures: list, vao=None) -> None:
+    """Draw the geometry one material range at a time with that material's uniforms (common/materials.glsl)."""
+    import moderngl
+
+    vao = vao or geometry.vao_full
+    for mat_index, first, count in geometry.ranges:
+        bind_material(prog, scene, mat_index, textures)
+        vao.render(moderngl.TRIANGLES, vertices=count, first=first)

@@ -1,0 +1,61 @@
+"""Shadow maps of every light in one depth atlas, with the light, view and polygon records the shaders read
+(common/lights.py builds them; direct/eval.glsl reads them)."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..common import lights as lb
+from ..gl.bind import ssbo
+from ..scene import Scene
+from .geometry import GeometryBuffers
+
+
+@dataclass
+class ShadowAtlas:
+    depth: object  # depth texture with comparison enabled
+    size: tuple
+    light_ssbo: object
+    view_ssbo: object
+    polygon_ssbo: object
+    light_count: int
+    view_count: int
+    warnings: list
+    buffers: lb.LightBuffers  # the CPU-side records (RSMs reuse the views)
+
+    def release(self):
+        for obj in (self.depth, self.light_ssbo, self.view_ssbo, self.polygon_ssbo):
+            obj.release()
+
+
+def render_shadow_atlas(ctx, programs, scene: Scene, geometry: GeometryBuffers,
+                        settings: lb.ShadowSettings) -> ShadowAtlas:
+    """Render every light's shadow views into one depth atlas and upload the light/view/polygon buffers."""
+    import moderngl
+
+    buffers = lb.build_light_buffers(scene, settings)
+    max_size = ctx.info.get("GL_MAX_TEXTURE_SIZE", 16384)
+    tiles, size, scale = lb.allocate_atlas([v.resolution for v in buffers.views], max_height=max_size)
+    warnings = list(buffers.warnings)
+    if scale > 1:
+        warnings.append(f"shadow maps reduced {scale}x to fit the atlas ({len(buffers.views)} views)")
+    depth = ctx.depth_texture(size)
+    depth.compare_func = "<="
+    depth.filter = (moderngl.LINEAR, moderngl.LINEAR)
+    depth.repeat_x = depth.repeat_y = False
+    if buffers.views:
+        fbo = ctx.framebuffer(depth_attachment=depth)
+        fbo.use()
+        fbo.clear(depth=1.0)
+        ctx.enable(moderngl.DEPTH_TEST)
+        ctx.disable(moderngl.CULL_FACE)
+        prog = programs.raster("direct/shadow_depth.glsl")
+        for view, (x, y, w, h) in zip(buffers.views, tiles):
+            fbo.viewport = (x, y, w, h)
+            prog["u_view_projection"].write(view.view_projection.T.astype("f4").tobytes())
+            prog["u_origin"].value = tuple(float(c) for c in view.origin)
+            prog["u_far"].value = float(view.far)
+            geometry.vao_depth.render(moderngl.TRIANGLES)
+        fbo.release()
+    views = lb.pack_views(buffers.views, tiles, size, settings.pcf_radius, buffers.view_lights)
+    return ShadowAtlas(depth, size, ssbo(ctx, buffers.lights), ssbo(ctx, views), ssbo(ctx, buffers.polygon_vertices),
+                       len(buffers.lights), len(buffers.views), warnings, buffers)

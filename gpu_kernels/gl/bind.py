@@ -1,0 +1,121 @@
+"""One helper per way a pass hands data to a shader: uniforms, samplers, images, dispatch, the grid, the lights,
+and the texture allocations and read-backs every stage shares. Stages call these rather than moderngl directly,
+so a uniform or a binding is spelled one way everywhere."""
+from __future__ import annotations
+
+import numpy as np
+
+
+def set_uniform(prog, name, value):
+    """Set a uniform if the compiler kept it (unused uniforms are optimised away)."""
+    if name in prog:
+        prog[name].value = value
+
+
+def write_uniform(prog, name, array: np.ndarray) -> None:
+    """Write a uniform (array, matrix) as raw float32 bytes if the compiler kept it."""
+    if name in prog:
+        prog[name].write(np.ascontiguousarray(array, np.float32).tobytes())
+
+
+def bind_samplers(prog, name: str, textures: list, first: int) -> int:
+    """Bind `textures` to consecutive texture units from `first` and point sampler (array) `name` at them;
+    returns the next free unit."""
+    for i, t in enumerate(textures):
+        t.use(location=first + i)
+    if name in prog:
+        units = list(range(first, first + len(textures)))
+        prog[name].value = units if prog[name].array_length > 1 else units[0]
+    return first + len(textures)
+
+
+def bind_images(textures: list, first: int = 0, read: bool = False, write: bool = True, level: int = 0) -> int:
+    """Bind `textures` to consecutive image units from `first`; returns the next free unit."""
+    for i, t in enumerate(textures):
+        t.bind_to_image(first + i, read=read, write=write, level=level)
+    return first + len(textures)
+
+
+def groups(size, local: int) -> tuple:
+    """Work groups that cover `size` invocations per axis with `local` invocations per group."""
+    return tuple((int(n) + local - 1) // local for n in size)
+
+
+def dispatch(prog, size, local: int = 4) -> None:
+    """Run a compute program over `size` (1 to 3 axes) with `local`-wide work groups on every axis given."""
+    g = groups(size, local)
+    prog.run(*(g + (1,) * (3 - len(g))))
+
+
+def bind_grid(prog, grid, levels: int | None = None) -> None:
+    """The grid uniforms every voxel shader names alike: u_grid_origin, u_grid_cell, u_grid_size (and u_max_lod
+    when the volumes have mip `levels`)."""
+    set_uniform(prog, "u_grid_origin", tuple(float(c) for c in grid.origin))
+    set_uniform(prog, "u_grid_cell", float(grid.cell))
+    set_uniform(prog, "u_grid_size", tuple(int(n) for n in grid.size))
+    if levels is not None:
+        set_uniform(prog, "u_max_lod", float(levels - 1))
+
+
+def bind_lights(prog, shadows, unit: int) -> int:
+    """The lights, shadow views, polygons and shadow atlas of direct/eval.glsl (storage buffers 0–2, the atlas on
+    texture unit `unit`); returns the next free unit."""
+    shadows.depth.use(location=unit)
+    set_uniform(prog, "u_shadow_atlas", unit)
+    set_uniform(prog, "u_atlas_texel", (1.0 / shadows.size[0], 1.0 / shadows.size[1]))
+    set_uniform(prog, "u_light_count", shadows.light_count)
+    shadows.light_ssbo.bind_to_storage_buffer(0)
+    shadows.view_ssbo.bind_to_storage_buffer(1)
+    shadows.polygon_ssbo.bind_to_storage_buffer(2)
+    return unit + 1
+
+
+def ssbo(ctx, array: np.ndarray):
+    """A storage buffer holding `array` (16 zero bytes when it is empty: GL refuses empty buffers)."""
+    data = np.ascontiguousarray(array).tobytes()
+    return ctx.buffer(data if data else b"\0" * 16)
+
+
+def zero_texture(ctx, texture) -> None:
+    """Fill `texture` (level 0) with zero bytes from a GPU-side buffer kept on the context (`ctx.extra`).
+
+    Why not `texture.write(bytes(n))`: that builds the zeros in Python and copies them to the GPU every time —
+    3.2 GB for the twelve 256³ RGBA32F face volumes of vct_inject, which took 4.6 s of the pass on an H200
+    (benchmarks/results/h200). From a buffer object the copy stays on the device (and is faster on llvmpipe too).
+    """
+    nbytes = texture.width * texture.height * getattr(texture, "depth", 1) * texture.components * \
+        {"f1": 1, "u1": 1, "i1": 1, "f2": 2, "u2": 2, "i2": 2}.get(texture.dtype, 4)
+    if not isinstance(ctx.extra, dict):
+        ctx.extra = {}
+    zeros = ctx.extra.get("bounce_gi_zeros")
+    if zeros is None or zeros.size < nbytes:
+        if zeros is not None:
+            zeros.release()
+        zeros = ctx.buffer(reserve=nbytes)
+        zeros.clear()
+        ctx.extra["bounce_gi_zeros"] = zeros
+    texture.write(zeros)
+
+
+def texture3d(ctx, size, levels: int = 1, zero: bool = False):
+    """An RGBA32F volume; `zero`: filled with zeros, so passes may skip storing to empty voxels (llvmpipe image
+    stores are slow: storing 12 zeros to every empty voxel took 1 s of vct_inject at 128³)."""
+    import moderngl
+
+    t = ctx.texture3d(tuple(int(n) for n in size), 4, None, dtype="f4")
+    if zero:
+        zero_texture(ctx, t)
+    t.repeat_x = t.repeat_y = t.repeat_z = False
+    if levels > 1:
+        t.build_mipmaps(0, levels - 1)  # allocates the chain; every level is then overwritten by vct/mipmap.glsl
+        t.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
+    else:
+        t.filter = (moderngl.NEAREST, moderngl.NEAREST)
+    return t
+
+
+def read_texture(texture, components: int = 4) -> np.ndarray:
+    """RGBA32F texture → (H, W, components) float32 with rows top-to-bottom (image order)."""
+    w, h = texture.size
+    data = np.frombuffer(texture.read(), np.float32).reshape(h, w, 4)
+    return np.ascontiguousarray(data[::-1, :, :components])

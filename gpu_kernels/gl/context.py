@@ -1,0 +1,98 @@
+"""The one moderngl context, owned by one dedicated worker thread.
+
+Why a thread: a moderngl context created on Blender's main thread silently breaks Blender's own drawing
+(design.md §4), and GL contexts are bound to the thread that made them current. So every GPU call in this
+package runs as a job on `GpuWorker`'s thread; callers get a `concurrent.futures.Future` and results come back
+as numpy arrays.
+"""
+from __future__ import annotations
+
+import platform
+import queue
+import threading
+from concurrent.futures import Future
+
+REQUIRED_GL = 430  # compute shaders and image load/store
+
+
+class GpuUnavailableError(RuntimeError):
+    """No OpenGL 4.3 context could be made; the message says why in one line."""
+
+
+def create_context():
+    """Create a standalone OpenGL ≥ 4.3 context: EGL first (headless, works with Mesa llvmpipe), then the default."""
+    import moderngl
+
+    if platform.system() == "Darwin":
+        raise GpuUnavailableError(
+            "Bounce GI needs OpenGL 4.3 compute shaders; macOS stops at OpenGL 4.1, so it cannot run there")
+    errors = []
+    backends = ("egl", None) if platform.system() == "Linux" else (None,)
+    for backend in backends:
+        try:
+            kwargs = {"require": REQUIRED_GL}
+            if backend:
+                kwargs["backend"] = backend
+            return moderngl.create_standalone_context(**kwargs)
+        except Exception as exc:  # moderngl raises plain Exception for version/backend problems
+            errors.append(f"{backend or 'default'}: {str(exc).strip().splitlines()[0] if str(exc).strip() else exc!r}")
+    raise GpuUnavailableError("could not create an OpenGL 4.3 context (" + "; ".join(errors) + ")")
+
+
+class GpuWorker:
+    """A daemon thread that owns the GL context and runs submitted jobs in order.
+
+    `submit(fn, *args)` runs `fn(ctx, *args)` on the worker and returns a Future. The context is created lazily by
+    the first job, so constructing a worker costs nothing and a missing GPU shows up as that job's exception.
+    """
+
+    def __init__(self, context_factory=create_context):
+        self._factory = context_factory
+        self._jobs: queue.Queue = queue.Queue()
+        self._ctx = None
+        self._ctx_error: BaseException | None = None
+        self._thread = threading.Thread(target=self._loop, name="bounce-gi-gpu", daemon=True)
+        self._thread.start()
+
+    def submit(self, fn, *args, **kwargs) -> Future:
+        future: Future = Future()
+        self._jobs.put((future, fn, args, kwargs))
+        return future
+
+    def call(self, fn, *args, **kwargs):
+        """Run `fn(ctx, ...)` on the worker and wait for its result (re-raises its exception)."""
+        return self.submit(fn, *args, **kwargs).result()
+
+    @property
+    def thread(self) -> threading.Thread:
+        return self._thread
+
+    def _loop(self) -> None:
+        while True:
+            future, fn, args, kwargs = self._jobs.get()
+            if fn is None:  # shutdown sentinel
+                future.set_result(None)
+                return
+            if not future.set_running_or_notify_cancel():
+                continue
+            try:
+                if self._ctx is None and self._ctx_error is None:
+                    try:
+                        self._ctx = self._factory()
+                    except BaseException as exc:  # remember: every later job gets the same clear error
+                        self._ctx_error = exc
+                if self._ctx_error is not None:
+                    raise self._ctx_error
+                future.set_result(fn(self._ctx, *args, **kwargs))
+            except BaseException as exc:
+                future.set_exception(exc)
+
+    def shutdown(self) -> None:
+        """Release the context and stop the thread (waits for queued jobs)."""
+        def release(ctx):
+            ctx.release()
+        if self._ctx is not None:
+            self.submit(release).result()
+        done: Future = Future()
+        self._jobs.put((done, None, (), {}))
+        done.result()

@@ -1,0 +1,242 @@
+"""The LPV's gathered transport (LpvSettings.transport = "gather", the default): light goes straight from lists of
+VPLs to the surface voxels of the geometry volume, with fuzzy visibility through it (lpv/gather.glsl), instead of
+through the Kaplanyan–Dachsbacher propagation.
+
+Why: the face scheme re-emits, at every cell, what each face received as a cosine lobe toward that face; a lobe
+pointing up keeps only 0.096 of its flux going up (the rest turns sideways), so light from a lit floor returns to
+the floor instead of reaching the ceiling — Cornell box DI rel-L1 0.69, ceiling at 0.14× Cycles. The gather keeps
+the LPV's pieces (RSM VPLs with their injection's flux, the geometry volume's surface voxels, their absorbed
+irradiance that the flux lookup reads and the next bounce reflects) and replaces only the transport:
+
+- first bounce: the RSM texels, clustered k×k into at most `gather_vpls` VPLs (`vpl_list`);
+- each further bounce: the light the surface voxels reflect, clustered into S×S×S blocks (`bounce_vpls`);
+- world light still enters through the open border and propagates (lpv/sky.glsl).
+
+Cost: voxels × VPLs × (distance / cell) samples per bounce — independent of the propagation's iteration count.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..common.bounce_tail import tail_ratio, tail_sum
+from ..common.grid import Grid
+from ..gl.bind import bind_grid, dispatch, set_uniform, zero_texture
+from .occlusion import absorb
+from .propagate import propagate
+from .settings import LpvSettings
+from .state import LpvGridState
+
+VPL_DTYPE = np.dtype([("position", "<f4", 4), ("normal", "<f4", 4), ("flux", "<f4", 4)])
+MAX_BLOCK = 16  # RSM texels per VPL side (tiles are multiples of 16) and fine voxels per cluster side
+PRECLUSTER = 64  # the GPU clusters blocks until at most this many slots per VPL of the budget are read back
+
+
+@dataclass
+class VplList:
+    """VPLs as a storage buffer of VPL_DTYPE records: position (w = 1), unit normal (w = area or 0), rgb flux."""
+    buffer: object
+    count: int
+    flux_rgb: tuple  # total flux per channel (W)
+    block: int  # k: RSM texels, or S: fine voxels, per VPL side
+
+    @property
+    def flux(self) -> float:
+        """Total flux, sum of RGB (W)."""
+        return float(sum(self.flux_rgb))
+
+    def release(self):
+        self.buffer.release()
+
+
+def rsm_uniforms(prog, rsm, shadows, downsample: int) -> tuple:
+    """Bind what lpv/inject.glsl reads of the RSM and the lights; returns the atlas size in k×k blocks."""
+    for unit, tex in enumerate((rsm.position, rsm.normal, rsm.albedo)):
+        tex.use(location=unit)
+    set_uniform(prog, "u_rsm_position", 0)
+    set_uniform(prog, "u_rsm_normal", 1)
+    set_uniform(prog, "u_rsm_albedo", 2)
+    set_uniform(prog, "u_rsm_size", rsm.size)
+    set_uniform(prog, "u_rsm_resolution", int(rsm.resolution))
+    set_uniform(prog, "u_downsample", int(downsample))
+    shadows.light_ssbo.bind_to_storage_buffer(0)
+    shadows.view_ssbo.bind_to_storage_buffer(1)
+    shadows.polygon_ssbo.bind_to_storage_buffer(2)
+    rsm.views_ssbo.bind_to_storage_buffer(3)
+    return (rsm.size[0] + downsample - 1) // downsample, (rsm.size[1] + downsample - 1) // downsample
+
+
+def _collect(ctx, slots: int, run) -> np.ndarray:
+    """Run a VPL-writing pass into `slots` zeroed records (binding 6) and keep the ones it wrote (w = 1)."""
+    buf = ctx.buffer(reserve=max(slots, 1) * VPL_DTYPE.itemsize)
+    buf.clear()
+    buf.bind_to_storage_buffer(6)
+    run()
+    records = np.frombuffer(buf.read(), VPL_DTYPE)
+    buf.release()
+    return records[records["position"][:, 3] > 0.5]
+
+
+def merge(records: np.ndarray, size: float) -> np.ndarray:
+    """Merge VPLs that share a cube of side `size` and a dominant normal direction (±x, ±y, ±z: a floor and the
+    wall beside it stay apart): flux and area add up, position and normal are luminance-weighted means — flux is
+    kept exactly. Also merges across RSM views (an area light's sample points each see the same floor)."""
+    pos, normal, flux = records["position"][:, :3], records["normal"][:, :3], records["flux"][:, :3]
+    axis = np.argmax(np.abs(normal), axis=1)
+    side = 2 * axis + (normal[np.arange(len(normal)), axis] < 0)
+    cube = np.floor(pos / size).astype(np.int64)
+    cube -= cube.min(axis=0)
+    span = cube.max(axis=0) + 1
+    key = ((cube[:, 0] * span[1] + cube[:, 1]) * span[2] + cube[:, 2]) * 6 + side
+    _, group = np.unique(key, return_inverse=True)
+    groups = int(group.max()) + 1
+    w = np.maximum(flux.astype(np.float64) @ (0.2126, 0.7152, 0.0722), 1e-30)
+
+    def total(values):
+        return np.stack([np.bincount(group, values[:, i], groups) for i in range(values.shape[1])], axis=1)
+
+    out = np.zeros(groups, VPL_DTYPE)
+    wsum = np.bincount(group, w, groups)[:, None]
+    out["position"][:, :3] = total(pos * w[:, None]) / wsum
+    out["position"][:, 3] = 1.0
+    n = total(normal * w[:, None])
+    out["normal"][:, :3] = n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-30)
+    out["normal"][:, 3] = np.bincount(group, records["normal"][:, 3].astype(np.float64), groups)
+    out["flux"][:, :3] = total(flux.astype(np.float64))
+    return out
+
+
+def _fitted(ctx, records: np.ndarray, size: float, block: int, budget: int) -> VplList:
+    """`records` merged (`merge`) in cubes of side `size`, doubled until at most `budget` VPLs remain."""
+    while len(records) > budget:
+        records = merge(records, size)
+        size *= 2
+    payload = records.tobytes() if len(records) else np.zeros(1, VPL_DTYPE).tobytes()
+    flux = tuple(float(c) for c in records["flux"][:, :3].astype(np.float64).sum(axis=0))
+    return VplList(ctx.buffer(payload), len(records), flux, block)
+
+
+def vpl_list(ctx, programs, rsm, shadows, grid: Grid, budget: int) -> VplList:
+    """The RSM as at most `budget` VPLs: k×k texel blocks (intensity-aware, lpv/inject.glsl MODE_LIST), k the
+    smallest power of two whose lit blocks fit (much of an atlas is empty: a sun's map covers the whole grid, a
+    spot's cone a disc). A block spanning two surfaces gives two VPLs; the grid's cell sets the plane tolerance."""
+    prog = programs.compute("lpv/inject.glsl", {"MODE_LIST": 1})
+    bind_grid(prog, grid)
+
+    def cluster(k):
+        blocks = rsm_uniforms(prog, rsm, shadows, k)
+        set_uniform(prog, "u_blocks_x", int(blocks[0]))
+        return _collect(ctx, 2 * blocks[0] * blocks[1],
+                        lambda: dispatch(prog, (blocks[0], blocks[1]), local=8))
+
+    k = 1
+    while k < MAX_BLOCK and -(-rsm.size[0] // k) * -(-rsm.size[1] // k) > PRECLUSTER * budget:
+        k *= 2  # cluster on the GPU first, so that the read-back stays a few times the budget
+    return _fitted(ctx, cluster(k), grid.cell / 2, k, budget)
+
+
+def bounce_vpls(ctx, programs, state: LpvGridState, gv, budget: int) -> VplList:
+    """The light the surface voxels reflect (albedo × last pass's irradiance × area, per side) as at most `budget`
+    VPLs: S×S×S voxel blocks, up to three per block split by plane (lpv/cluster.glsl), S from 2 up."""
+    prog = programs.compute("lpv/cluster.glsl")
+    for unit, (name, tex) in enumerate((("u_front", state.front), ("u_back", state.back),
+                                        ("u_voxel_normal", gv.normal), ("u_voxel_area", gv.area),
+                                        ("u_voxel_albedo", gv.albedo))):
+        tex.use(location=unit)
+        set_uniform(prog, name, unit)
+    set_uniform(prog, "u_fine_origin", tuple(float(c) for c in gv.fine.origin))
+    set_uniform(prog, "u_fine_size", tuple(gv.fine.size))
+    set_uniform(prog, "u_voxel", float(gv.fine.cell))
+
+    block = 1
+    while block < MAX_BLOCK and 3 * np.prod([-(-n // block) for n in gv.fine.size]) > PRECLUSTER * budget:
+        block *= 2
+    blocks = tuple(-(-n // block) for n in gv.fine.size)
+    set_uniform(prog, "u_block", int(block))
+    set_uniform(prog, "u_blocks", blocks)
+    records = _collect(ctx, 3 * int(np.prod(blocks)), lambda: dispatch(prog, blocks))
+    return _fitted(ctx, records, gv.fine.cell * block, block, budget)
+
+
+def extrapolate_tail(ctx, programs, state: LpvGridState, gv, tail) -> None:
+    """Add this pass's front/back irradiance × `tail` (RGB) to the totals (lpv/tail.glsl)."""
+    prog = programs.compute("lpv/tail.glsl")
+    for unit, name in enumerate(("front", "back", "front_total", "back_total")):
+        getattr(state, name).bind_to_image(unit, read=True, write=unit >= 2)
+    set_uniform(prog, "u_size", tuple(gv.fine.size))
+    set_uniform(prog, "u_tail", tuple(float(t) for t in tail))
+    dispatch(prog, gv.fine.size)
+
+
+def vpls_per_dispatch(grid: Grid) -> int:
+    """VPLs one gather dispatch takes. llvmpipe stops a shader invocation's loops after 65535 iterations in all
+    (LP_MAX_TGSI_LOOP_ITERATIONS, shared between every loop of a shader): past it the gather silently dropped the
+    later VPLs' light. A VPL costs at most one visibility step per cell a straight line can visit (nx + ny + nz +
+    3) plus its near-field quarter discs; half the limit leaves room for the rest."""
+    return max(1, 32768 // (sum(int(n) for n in grid.size) + 8))
+
+
+def gather(ctx, programs, state: LpvGridState, gv, vpls: VplList, occlusion: bool, fresh: bool) -> None:
+    """Add the irradiance every surface voxel receives straight from `vpls` (lpv/gather.glsl) to this pass's front
+    and back irradiance (cleared first when `fresh`: a further bounce's pass) and to their totals."""
+    if fresh:
+        zero_texture(ctx, state.front)
+        zero_texture(ctx, state.back)
+    if vpls.count == 0:
+        return
+    prog = programs.compute("lpv/gather.glsl")
+    for unit, (name, tex) in enumerate((("u_voxel_normal", gv.normal), ("u_voxel_area", gv.area),
+                                        ("u_coverage", gv.coverage), ("u_layers", gv.layers))):
+        tex.use(location=unit)
+        set_uniform(prog, name, unit)
+    set_uniform(prog, "u_occlusion", bool(occlusion))
+    set_uniform(prog, "u_fine_origin", tuple(float(c) for c in gv.fine.origin))
+    bind_grid(prog, state.grid)
+    vpls.buffer.bind_to_storage_buffer(6)
+    gv.surfaces.bind_to_storage_buffer(7)
+    set_uniform(prog, "u_surface_count", int(gv.surface_count))
+    for unit, name in enumerate(("front", "back", "front_total", "back_total")):
+        getattr(state, name).bind_to_image(unit, read=True, write=True)
+    chunk = vpls_per_dispatch(state.grid)
+    for first in range(0, vpls.count, chunk):
+        set_uniform(prog, "u_vpl_first", first)
+        set_uniform(prog, "u_vpl_count", min(chunk, vpls.count - first))
+        dispatch(prog, (gv.surface_count,), local=64)
+        ctx.memory_barrier()
+
+
+def gather_all(ctx, programs, states: list, gvs: list, settings: LpvSettings) -> dict:
+    """The gathered transport (lpv_gather.py), per cascade: world light propagates and is absorbed as in
+    `propagate_all`; the RSM's VPLs (state.vpls) and then, bounce by bounce, the light the surface voxels reflect
+    are gathered straight to the surface voxels."""
+    stats = []
+    for state, gv in zip(states, gvs):
+        state.face_flux.clear()
+        iterations = 0
+        if state.injected_flux > 0:  # world light: the only light injected for this transport
+            iterations = propagate(ctx, programs, state, state.injected, state.injected_flux, gv.blocking, settings,
+                                   accumulate=False)["iterations"]
+        absorb(ctx, programs, state, gv, add=False)  # the world light's irradiance (zeros without it)
+        bounces = []
+        gathered = min(settings.bounces, settings.gathered_bounces or settings.bounces)
+        vpls = state.vpls
+        for bounce in range(gathered):
+            gather(ctx, programs, state, gv, vpls, settings.occlusion, fresh=bounce > 0)
+            bounces.append({"vpls": vpls.count, "flux": vpls.flux, "block": vpls.block})
+            if bounce > 0:
+                vpls.release()
+            if vpls.count == 0 or bounce + 1 == settings.bounces:
+                break
+            previous = vpls.flux_rgb
+            vpls = bounce_vpls(ctx, programs, state, gv, settings.gather_vpls)
+            if bounce + 1 == gathered:  # bounces gathered + 1 … N: extrapolated from the flux ratio
+                vpls.release()
+                ratio = tail_ratio(vpls.flux_rgb, previous)
+                n = settings.bounces - gathered
+                extrapolate_tail(ctx, programs, state, gv, tail_sum(ratio, n))
+                bounces.append({"extrapolated": n, "ratio": [float(r) for r in ratio]})
+        stats.append({"cells": list(state.grid.size), "cell": state.grid.cell,
+                      "injected_flux": state.injected_flux + state.vpls.flux, "world_flux": state.injected_flux,
+                      "bounces": bounces, "iterations": iterations})
+    return {"cascades": stats}

@@ -1,0 +1,46 @@
+"""lpv_lighting: Diffuse Indirect per G-buffer pixel from the cascades — the surface voxels' absorbed irradiance
+(the flux lookup) or the SH intensity convolved with the cosine (Kaplanyan's lookup)."""
+from __future__ import annotations
+
+from ..gl.bind import dispatch, set_uniform
+from .settings import LpvSettings
+
+
+def lighting(ctx, programs, gbuffer, states: list, gvs: list, settings: LpvSettings):
+    """Diffuse Indirect (irradiance/π) per G-buffer pixel from the accumulated volumes (RGBA32F texture)."""
+    w, h = gbuffer.size
+    out = ctx.texture((w, h), 4, dtype="f4")
+    flux_mode = settings.lookup == "flux" and all(g is not None for g in gvs)
+    prog = programs.compute("lpv/lighting.glsl", {"MODE_FLUX": 1} if flux_mode else None)
+    out.bind_to_image(0, read=False, write=True)
+    gbuffer.textures["position"].use(location=0)
+    gbuffer.textures["normal"].use(location=1)
+    set_uniform(prog, "u_position", 0)
+    set_uniform(prog, "u_normal", 1)
+    unit = 2
+    n = len(states)
+    per_cascade = {f"u_accum_{c}": [s.accum.textures()[i] for s in states] for i, c in enumerate("rgb")}
+    if flux_mode:
+        per_cascade = {"u_front": [s.front_total for s in states], "u_back": [s.back_total for s in states],
+                       "u_voxel_normal": [g.normal for g in gvs]}
+        fine_origin = [tuple(float(c) for c in g.fine.origin) for g in gvs]
+        set_uniform(prog, "u_fine_origin", fine_origin + [fine_origin[-1]] * (4 - n))
+        set_uniform(prog, "u_fine_size", [tuple(g.fine.size) for g in gvs] + [(1, 1, 1)] * (4 - n))
+    for name, texs in per_cascade.items():
+        units = []
+        for tex in texs:
+            tex.use(location=unit)
+            units.append(unit)
+            unit += 1
+        units += [units[-1]] * (4 - n)
+        set_uniform(prog, name, units)
+    origins = [tuple(float(c) for c in s.grid.origin) for s in states]
+    set_uniform(prog, "u_grid_origin", origins + [origins[-1]] * (4 - n))
+    set_uniform(prog, "u_grid_cell", [float(s.grid.cell) for s in states] + [1.0] * (4 - n))
+    set_uniform(prog, "u_grid_size", [tuple(int(c) for c in s.grid.size) for s in states] + [(1, 1, 1)] * (4 - n))
+    set_uniform(prog, "u_cascades", n)
+    set_uniform(prog, "u_blend_cells", float(settings.blend_cells))
+    set_uniform(prog, "u_damping", bool(settings.damping))
+    set_uniform(prog, "u_image_size", (w, h))
+    dispatch(prog, (w, h), local=8)
+    return out

@@ -1,0 +1,186 @@
+"""LPV fuzzy occlusion and the light it stops (seed 000 §3.4): the geometry volume, built from a voxelisation of
+the whole scene, blocks light at cell faces; the flux it blocks is the light the surfaces there absorb, which
+gives their irradiance (lpv/absorb.glsl) and, times albedo, the next bounce's VPLs (lpv/bounce.glsl).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..common.grid import Grid
+from ..gl.bind import bind_grid, dispatch, set_uniform
+from ..scene import Scene
+from .state import FIXED_RANGE, LpvGridState, resolve
+
+@dataclass
+class GeometryVolume:
+    """Fuzzy occlusion of one cascade (seed 000 §3.4) and the surface voxels that absorb what it stops."""
+    blocking: object  # RGBA32F 3D texture, LPV size + 1: channel a = blocked fraction of cell c's lower face normal to a
+    fine: Grid  # surface voxels: half the LPV cell, offset by half an LPV cell
+    area: object  # fine voxel textures from voxelize(): projected areas per axis + total area
+    normal: object
+    albedo: object
+    coverage: object = None  # per LPV cell (crossing_layers): its surfaces' plane(s) and covered fraction
+    layers: object = None  # per LPV cell: where those planes lie (cells from the grid origin)
+    surfaces: object = None  # storage buffer: (x, y, z, 0) int32 of every fine voxel holding a surface
+    surface_count: int = 0
+
+    def release(self):
+        for t in (self.blocking, self.area, self.normal, self.albedo, self.coverage, self.layers, self.surfaces):
+            if t is not None:
+                t.release()
+
+
+def face_blocking(area: np.ndarray, grid: Grid) -> np.ndarray:
+    """Blocked fraction of every LPV face from surface voxels of half the cell size (fine grid, origin − cell/2).
+
+    The face between cells c − e_a and c gets the blocking potential of seed 000 §3.4, B = Σ A_s·|n_s·a| / s²
+    (clamped to 1), summed over the surfels inside the cell-sized box centred on that face — exactly the eight
+    fine voxels [2c_a, 2c_a+2) along a and [2c_u+1, 2c_u+3) along the other axes. (A box centred on the face,
+    rather than the four corner cells of the classic GV, which average over 2s × 2s and so let a 45° wall block
+    only half of each face it crosses.) Returns (nz+1, ny+1, nx+1, 4), channel a at the index of cell c.
+    """
+    nx, ny, nz = grid.size
+    out = np.zeros((nz + 1, ny + 1, nx + 1, 4), np.float64)
+    s2 = grid.cell ** 2
+    proj = [area[..., a] for a in range(3)]  # fine arrays indexed [z, y, x]
+    # axis x: pairs [2i, 2i+2) along x, [2j+1, 2j+3) along y, [2k+1, 2k+3) along z
+    px = proj[0][1:2 * nz + 1, 1:2 * ny + 1, 0:2 * nx + 2]
+    out[:nz, :ny, :, 0] = px.reshape(nz, 2, ny, 2, nx + 1, 2).sum(axis=(1, 3, 5)) / s2
+    py = proj[1][1:2 * nz + 1, 0:2 * ny + 2, 1:2 * nx + 1]
+    out[:nz, :, :nx, 1] = py.reshape(nz, 2, ny + 1, 2, nx, 2).sum(axis=(1, 3, 5)) / s2
+    pz = proj[2][0:2 * nz + 2, 1:2 * ny + 1, 1:2 * nx + 1]
+    out[:, :ny, :nx, 2] = pz.reshape(nz + 1, 2, ny, 2, nx, 2).sum(axis=(1, 3, 5)) / s2
+    out[..., :3] = np.minimum(out[..., :3], 1.0)
+    return out.astype(np.float32)
+
+
+PLANAR = 0.9  # a cell whose surfaces' normals share one plane this closely (λ_max / trace) is one oblique plane
+
+
+def crossing_layers(area: np.ndarray, normal: np.ndarray, grid: Grid) -> tuple[np.ndarray, np.ndarray]:
+    """Where each LPV cell's surfaces lie, for the gathered transport's visibility (lpv/gather.glsl): a ray that
+    crosses them inside the cell is stopped by the fraction of the cell they cover.
+
+    A cell whose surfaces are one plane (the area-weighted normal tensor Σ A·n·nᵀ has one dominant direction,
+    λ_max / trace ≥ PLANAR: a wall, a floor, a patch of a sphere) is that plane — normal n (the principal axis,
+    sign-free), offset n·x over its voxels' centres, coverage min(1, area / cell²). Otherwise (an edge or corner
+    where a floor meets a wall) it is three axis planes, one per axis a: coverage min(1, projected area / cell²)
+    at the projected-area-weighted mean coordinate. Axis planes alone would turn a sphere into a staircase that
+    rays leaving it at a grazing angle cross; one mean plane alone would put a diagonal wall across every corner.
+
+    Returns (nz, ny, nx, 4) arrays `coverage` and `layers`, in cells from the grid origin: for a plane cell
+    coverage = (n, −coverage), layers = (0, 0, 0, offset); for an axis cell coverage = (c_x, c_y, c_z, 0),
+    layers = (x̄, ȳ, z̄, 0); empty cells are zero. LPV cell c holds fine voxels [2c + 1, 2c + 3) along each axis
+    (fine voxel f's centre: (f + 0.5)/2 − 1/2 cells)."""
+    nx, ny, nz = grid.size
+    inner = (slice(1, 2 * nz + 1), slice(1, 2 * ny + 1), slice(1, 2 * nx + 1))
+    proj = area[inner][..., :3].astype(np.float64)
+    total = area[inner][..., 3].astype(np.float64)
+    n = normal[inner][..., :3].astype(np.float64)
+    n /= np.maximum(np.linalg.norm(n, axis=-1, keepdims=True), 1e-30)
+    zz, yy, xx = np.meshgrid(*[(np.arange(1, 2 * k + 1) + 0.5) / 2 - 0.5 for k in (nz, ny, nx)], indexing="ij")
+    centre = np.stack([xx, yy, zz], axis=-1)  # per fine voxel: (x, y, z) in cells
+
+    def per_cell(values):
+        return values.reshape(nz, 2, ny, 2, nx, 2, *values.shape[3:]).sum(axis=(1, 3, 5))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        proj_cell = per_cell(proj)
+        axis_layer = np.nan_to_num(per_cell(proj * centre) / proj_cell)
+        area_cell = per_cell(total)
+        tensor = per_cell(total[..., None, None] * n[..., :, None] * n[..., None, :])
+        eigval, eigvec = np.linalg.eigh(tensor)  # ascending
+        planar = (area_cell > 0) & (eigval[..., 2] >= PLANAR * np.maximum(eigval.sum(axis=-1), 1e-30))
+        plane_n = eigvec[..., :, 2]
+        offset = np.nan_to_num(np.einsum("zyxi,zyxi->zyx", per_cell(total[..., None] * centre), plane_n) / area_cell)
+    coverage = np.zeros((nz, ny, nx, 4), np.float32)
+    layers = np.zeros((nz, ny, nx, 4), np.float32)
+    coverage[..., :3] = np.minimum(proj_cell / grid.cell ** 2, 1.0)
+    layers[..., :3] = axis_layer
+    cov = np.minimum(area_cell / grid.cell ** 2, 1.0)
+    coverage[planar] = np.concatenate([plane_n[planar], -cov[planar][:, None]], axis=1)
+    layers[planar] = np.concatenate([np.zeros((planar.sum(), 3)), offset[planar][:, None]], axis=1)
+    return coverage, layers
+
+
+def geometry_volumes(ctx, programs, scene: Scene, geometry, textures, grids: list) -> list:
+    """Fuzzy-occlusion volumes, one per cascade, from a voxelisation of the whole scene (view-independent).
+
+    The blocking potential of seed 000 §3.4 is evaluated in closed form at the axis directions — B_a, the fraction
+    of a face normal to a that surfaces cover — instead of through a 2-band SH projection, because 2-band SH cannot
+    hold a two-sided blocker (the band-1 terms of |n·ω| vanish, which would leave a full wall blocking at most half
+    the light).
+    """
+    import moderngl
+
+    from ..voxel.voxelize import voxelize
+
+    out = []
+    for grid in grids:
+        fine = Grid(tuple(np.asarray(grid.origin) - grid.cell / 2), grid.cell / 2, tuple(2 * n + 2 for n in grid.size))
+        vox = voxelize(ctx, programs, scene, geometry, textures, fine)
+        area = vox.read()["area"]
+        blocking = face_blocking(area, grid)
+        tex = ctx.texture3d(tuple(n + 1 for n in grid.size), 4, np.ascontiguousarray(blocking).tobytes(), dtype="f4")
+        for t in (tex, vox.area, vox.normal, vox.albedo):
+            t.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        crossings = [ctx.texture3d(tuple(grid.size), 4, a.tobytes(), dtype="f4")
+                     for a in crossing_layers(area, vox.read()["normal"], grid)]
+        for t in crossings:
+            t.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        vox.emission.release()
+        # The gather runs over this list, not the whole fine grid: a workgroup straddling a wall would leave most
+        # of its SIMD lanes idle for the whole VPL loop.
+        z, y, x = np.nonzero(area[..., 3] > 0)
+        cells = np.stack([x, y, z, np.zeros_like(x)], axis=1).astype(np.int32)
+        surfaces = ctx.buffer(cells.tobytes() if len(cells) else np.zeros(4, np.int32).tobytes())
+        out.append(GeometryVolume(tex, fine, vox.area, vox.normal, vox.albedo, *crossings, surfaces, len(cells)))
+    return out
+
+
+def absorb(ctx, programs, state: LpvGridState, gv: GeometryVolume, add: bool) -> None:
+    """Front/back irradiance of every surface voxel from the flux occlusion stopped (lpv/absorb.glsl); `add`
+    adds it to the bounce totals instead of starting them."""
+    import moderngl
+
+    size = gv.fine.size
+    for name in ("front", "back", "front_total", "back_total"):
+        if getattr(state, name) is None:
+            t = ctx.texture3d(size, 4, dtype="f4")
+            t.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            setattr(state, name, t)
+    prog = programs.compute("lpv/absorb.glsl", {"MODE_ADD": 1} if add else None)
+    state.face_flux.bind_to_storage_buffer(6)
+    gv.blocking.use(location=0)
+    gv.normal.use(location=1)
+    gv.area.use(location=2)
+    set_uniform(prog, "u_geometry", 0)
+    set_uniform(prog, "u_voxel_normal", 1)
+    set_uniform(prog, "u_voxel_area", 2)
+    set_uniform(prog, "u_grid_size", tuple(int(c) for c in state.grid.size))
+    set_uniform(prog, "u_grid_cell", float(state.grid.cell))
+    for unit, name in enumerate(("front", "back", "front_total", "back_total")):
+        getattr(state, name).bind_to_image(unit, read=True, write=True)
+    dispatch(prog, size)
+
+
+def inject_bounce(ctx, programs, state: LpvGridState, gv: GeometryVolume, bound: float) -> float:
+    """Re-inject the light the surfaces absorbed in the last pass, times their albedo (lpv/bounce.glsl)."""
+    scale = FIXED_RANGE / max(bound, 1e-12)
+    state.accum_ints.clear()
+    prog = programs.compute("lpv/bounce.glsl")
+    for unit, (name, tex) in enumerate((("u_front", state.front), ("u_back", state.back),
+                                        ("u_voxel_normal", gv.normal), ("u_voxel_area", gv.area),
+                                        ("u_voxel_albedo", gv.albedo))):
+        tex.use(location=unit)
+        set_uniform(prog, name, unit)
+    set_uniform(prog, "u_fine_origin", tuple(float(c) for c in gv.fine.origin))
+    set_uniform(prog, "u_fine_size", tuple(gv.fine.size))
+    bind_grid(prog, state.grid)
+    set_uniform(prog, "u_fixed_scale", float(scale))
+    state.accum_ints.bind_to_storage_buffer(4)
+    dispatch(prog, gv.fine.size)
+    return resolve(ctx, programs, state, scale, state.ping)
+
+

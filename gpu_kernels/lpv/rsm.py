@@ -1,0 +1,95 @@
+"""Reflective shadow maps (Dachsbacher and Stamminger 2005, "Reflective Shadow Maps"): every shadow view of every
+light rendered once more as position, normal and albedo, the texels the VPLs are made from."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..common import lights as lb
+from ..direct.geometry import draw_by_material
+from ..gl.bind import set_uniform, ssbo
+from ..scene import Scene
+
+
+@dataclass
+class Rsm:
+    position: object
+    normal: object
+    albedo: object
+    views_ssbo: object
+    size: tuple
+    resolution: int
+    flux_bound: float
+    vao: object = None
+    fbo: object = None
+    depth: object = None
+
+    def release(self):
+        for obj in (self.position, self.normal, self.albedo, self.views_ssbo, self.fbo, self.depth, self.vao):
+            if obj is not None:
+                obj.release()
+
+
+RSM_VIEW_DTYPE = np.dtype([("params", "<f4", 4), ("origin", "<f4", 4), ("axis", "<f4", 4), ("right", "<f4", 4)])
+
+
+def flux_bound(buffers: lb.LightBuffers) -> float:
+    """An upper bound of the flux all lights together can deliver to surfaces (W), for the fixed-point scale."""
+    total = 0.0
+    for i, rec in enumerate(buffers.lights):
+        color = float(np.max(rec["color_type"][:3]))
+        kind = int(rec["color_type"][3])
+        if kind == lb.LIGHT_SUN:
+            views = [v for v, l in zip(buffers.views, buffers.view_lights) if l == i]
+            half = views[0].half_extent if views else 1.0
+            total += color * (2 * half) ** 2
+        elif kind in (lb.LIGHT_POINT, lb.LIGHT_SPOT):
+            total += color * 4 * math.pi
+        else:
+            first, count, two_sided = int(rec["polygon"][0]), int(rec["polygon"][1]), rec["polygon"][2] > 0.5
+            p = buffers.polygon_vertices[first:first + count, :3].astype(np.float64)
+            area = 0.5 * np.linalg.norm(sum(np.cross(p[j], p[(j + 1) % count]) for j in range(count)))
+            total += color * math.pi * area * (2 if two_sided else 1)
+    return max(total, 1e-12)
+
+
+def render_rsm(ctx, programs, scene: Scene, geometry, textures, shadows, resolution: int) -> Rsm:
+    """Render every shadow view of every light once more as an RSM (position, normal, albedo) into an atlas."""
+    import moderngl
+
+    buffers = shadows.buffers
+    views = buffers.views
+    res = [resolution * (2 if v.ortho else 1) for v in views]
+    tiles, size, scale = lb.allocate_atlas(res, max_height=ctx.info.get("GL_MAX_TEXTURE_SIZE", 16384))
+    targets = [ctx.texture(size, 4, dtype="f4") for _ in range(3)]
+    for t in targets:
+        t.filter = (moderngl.NEAREST, moderngl.NEAREST)
+    depth = ctx.depth_renderbuffer(size)
+    fbo = ctx.framebuffer(color_attachments=targets, depth_attachment=depth)
+    fbo.use()
+    fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+    ctx.enable(moderngl.DEPTH_TEST)
+    ctx.disable(moderngl.CULL_FACE)
+    prog = programs.raster("lpv/rsm.glsl")
+    vao = ctx.vertex_array(prog, [(geometry.vbo, "3f 3f 2f 3f", "in_position", "in_normal", "in_uv", "in_geo_normal")])
+    records = np.zeros(len(views), RSM_VIEW_DTYPE)
+    for i, (view, (x, y, w, h)) in enumerate(zip(views, tiles)):
+        fbo.viewport = (x, y, w, h)
+        prog["u_view_projection"].write(view.view_projection.T.astype("f4").tobytes())
+        right, back = view.view_matrix[0, :3], view.view_matrix[2, :3]  # rows of world → view: right, up, back
+        set_uniform(prog, "u_origin", tuple(float(c) for c in view.origin))
+        set_uniform(prog, "u_forward", tuple(float(c) for c in -back))
+        set_uniform(prog, "u_ortho", bool(view.ortho))
+        set_uniform(prog, "u_view_index", float(i))
+        draw_by_material(prog, scene, geometry, textures, vao=vao)
+        light = buffers.view_lights[i]
+        rec = buffers.lights[light]
+        k = (i - int(rec["params"][1])) // max(int(rec["params"][3]), 1)
+        records[i]["params"] = (0.0 if view.ortho else view.half_extent,
+                                2 * view.half_extent / w if view.ortho else 0.0, light, k)
+        records[i]["origin"] = (*view.origin, 1.0 if view.ortho else 0.0)
+        records[i]["axis"] = (*-back, 0.0)
+        records[i]["right"] = (*right, 0.0)
+    return Rsm(*targets, ssbo(ctx, records), size, resolution // scale, flux_bound(buffers), vao, fbo, depth)

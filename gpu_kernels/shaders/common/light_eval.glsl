@@ -1,0 +1,55 @@
+// Unshadowed light evaluation shared by direct lighting and RSM flux (one implementation of Cycles' light units).
+#pragma once
+#include "common/lights.glsl"
+
+const float PI = 3.14159265358979;
+
+// Cycles (kernel/light/spot.h): smoothstep(0, 1, (cos α − cos(half size)) · smooth), smooth = 1/((1−cos half)·blend);
+// `dir` is the unit direction from the light to the point.
+float spot_attenuation(GpuLight L, vec3 dir) {
+    float c = dot(dir, L.direction.xyz);
+    return L.params.x > 0.0 ? smoothstep(0.0, 1.0, (c - L.direction.w) * L.params.x) : float(c > L.direction.w);
+}
+
+// Cube of six views around an origin (+X, -X, +Y, -Y, +Z, -Z): pick the face the direction falls in.
+int cube_face(vec3 d) {
+    vec3 a = abs(d);
+    if (a.x >= a.y && a.x >= a.z) return d.x > 0.0 ? 0 : 1;
+    if (a.y >= a.z) return d.y > 0.0 ? 2 : 3;
+    return d.z > 0.0 ? 4 : 5;
+}
+
+// ∫ over the polygon of cosθ dω (projected solid angle), polygon clipped to the upper hemisphere of n.
+// Lambert's formula: Σ_edges angle(v_i, v_j) · n·normalize(v_i × v_j) / 2 (Arvo 1995, "Applications of irradiance
+// tensors"), with atan2 for the edge angle so short edges stay accurate.
+float polygon_projected_solid_angle(int first, int count, vec3 p, vec3 n) {
+    vec3 clipped[MAX_POLYGON_VERTICES];
+    int m = 0;
+    // A receiver in the polygon's own plane (e.g. the emitter itself) sees it edge-on: zero projected solid angle.
+    float max_height = 0.0, max_dist = 0.0;
+    for (int i = 0; i < count; ++i) {
+        vec3 a = polygon_vertices[first + i].xyz - p;
+        max_height = max(max_height, dot(a, n));
+        max_dist = max(max_dist, length(a));
+    }
+    if (max_height <= 1e-5 * max_dist) return 0.0;
+    for (int i = 0; i < count; ++i) {
+        vec3 a = polygon_vertices[first + i].xyz - p;
+        vec3 b = polygon_vertices[first + (i + 1) % count].xyz - p;
+        float ha = dot(a, n), hb = dot(b, n);
+        if (ha >= 0.0 && m < MAX_POLYGON_VERTICES) clipped[m++] = a;
+        if ((ha >= 0.0) != (hb >= 0.0) && m < MAX_POLYGON_VERTICES) clipped[m++] = a + (b - a) * (ha / (ha - hb));
+    }
+    if (m < 3) return 0.0;
+    float sum = 0.0;
+    for (int i = 0; i < m; ++i) {
+        vec3 a = normalize(clipped[i]);
+        vec3 b = normalize(clipped[(i + 1) % m]);
+        vec3 c = cross(a, b);
+        float s = length(c);
+        if (s < 1e-12) continue;
+        sum += atan(s, dot(a, b)) * dot(n, c) / s;
+    }
+    return abs(sum) * 0.5;
+}
+

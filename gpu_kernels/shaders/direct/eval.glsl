@@ -1,0 +1,115 @@
+// Shadowed direct irradiance of one light at a point (sun, point, spot, polygon), shared by the Diffuse Direct
+// pass (direct/light.glsl) and VCT radiance injection (vct/inject.glsl), so voxels are lit exactly like pixels.
+// Needs the light/view/polygon buffers of common/lights.glsl and the shadow atlas declared here.
+#pragma once
+#include "common/lights.glsl"
+#include "common/light_eval.glsl"
+
+uniform sampler2DShadow u_shadow_atlas;
+uniform vec2 u_atlas_texel;        // 1 / atlas size
+
+// Visibility of world point p from one shadow view with a normal-offset bias and percentage-closer filtering.
+// The offset grows with the shadow texel's world footprint, which removes acne without a hand-tuned constant.
+float view_visibility(int view_index, vec3 p, vec3 geo_n, vec3 to_light) {
+    ShadowView v = shadow_views[view_index];
+    bool ortho = v.origin.w > 0.5;
+    float dist = ortho ? 1.0 : length(p - v.origin.xyz);
+    float texel_world = v.info.x * dist;
+    float cos_l = clamp(dot(geo_n, to_light), 0.0, 1.0);
+    float sin_l = sqrt(max(0.0, 1.0 - cos_l * cos_l));
+    // 1.5 texels along the normal, more at grazing angles (slope-scaled), capped.
+    vec3 q = p + geo_n * texel_world * (1.5 + 2.0 * min(sin_l / max(cos_l, 0.05), 8.0));
+    vec4 clip = v.view_projection * vec4(q, 1.0);
+    vec3 ndc = clip.xyz / clip.w;
+    if (clip.w <= 0.0) return 1.0;
+    vec2 uv = ndc.xy * 0.5 + 0.5;
+    if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return 1.0;  // outside: unshadowed
+    // Same depth the shadow pass stored: rasterised z (ortho) or radial distance / far (perspective).
+    float depth = ortho ? ndc.z * 0.5 + 0.5 : length(q - v.origin.xyz) / v.info.z;
+    vec2 lo = v.tile.xy + 0.5 * u_atlas_texel;
+    vec2 hi = v.tile.xy + v.tile.zw - 0.5 * u_atlas_texel;
+    vec2 atlas_uv = v.tile.xy + uv * v.tile.zw;
+    // PCF: a (2r+1)² grid of bilinear hardware comparisons.
+    int r = int(v.info.y);
+    float sum = 0.0;
+    for (int j = -r; j <= r; ++j)
+        for (int i = -r; i <= r; ++i) {
+            vec2 s = clamp(atlas_uv + vec2(i, j) * u_atlas_texel, lo, hi);
+            sum += texture(u_shadow_atlas, vec3(s, depth));
+        }
+    return sum / float((2 * r + 1) * (2 * r + 1));
+}
+
+float cube_visibility(int first_view, vec3 p, vec3 geo_n) {
+    vec3 origin = shadow_views[first_view].origin.xyz;
+    vec3 to_light = normalize(origin - p);
+    return view_visibility(first_view + cube_face(p - origin), p, geo_n, to_light);
+}
+
+// Weighted visibility of a polygon light from its shadow sample points: each sample is weighted by its own
+// unshadowed point contribution (cosθ_light · cosθ_receiver / d²), so samples that light p more count more.
+float polygon_visibility(GpuLight L, vec3 p, vec3 n, vec3 geo_n) {
+    int samples = int(L.params.z);
+    if (samples == 0) return 1.0;
+    int first = int(L.params.y);
+    int per = int(L.params.w);
+    vec3 ln = L.direction.xyz;
+    bool two_sided = L.polygon.z > 0.5;
+    float wsum = 0.0, vsum = 0.0;
+    for (int k = 0; k < samples; ++k) {
+        int view0 = first + k * per;
+        vec3 o = shadow_views[view0].origin.xyz;
+        vec3 d = p - o;
+        float d2 = max(dot(d, d), 1e-8);
+        vec3 w = d * inversesqrt(d2);
+        // Two-sided emitters have one sample per side (even k: along the normal, odd k: against it); a sample
+        // only speaks for receivers on its own side.
+        vec3 side_n = (two_sided && (k % 2 == 1)) ? -ln : ln;
+        float cl = max(dot(side_n, w), 0.0);
+        float weight = cl * max(dot(n, -w), 0.0) / d2;
+        if (weight <= 0.0) continue;
+        wsum += weight;
+        vsum += weight * cube_visibility(view0, p, geo_n);
+    }
+    return wsum > 0.0 ? vsum / wsum : 1.0;
+}
+
+vec3 light_irradiance(GpuLight L, vec3 p, vec3 n, vec3 geo_n) {
+    int type = int(L.color_type.w);
+    vec3 color = L.color_type.rgb;
+    bool shadowed = L.params.z > 0.0;
+    if (type == LIGHT_SUN) {
+        vec3 wi = -L.direction.xyz;
+        float cosine = dot(n, wi);
+        if (cosine <= 0.0) return vec3(0.0);
+        float vis = shadowed ? view_visibility(int(L.params.y), p, geo_n, wi) : 1.0;
+        return color * cosine * vis;
+    }
+    if (type == LIGHT_POINT || type == LIGHT_SPOT) {
+        vec3 d = L.position.xyz - p;
+        float d2 = max(dot(d, d), 1e-8);
+        vec3 wi = d * inversesqrt(d2);
+        float cosine = dot(n, wi);
+        if (cosine <= 0.0) return vec3(0.0);
+        float att = 1.0;
+        if (type == LIGHT_SPOT) {
+            // Cycles (kernel/light/spot.h): smoothstep(0, 1, (cos α − cos(half size)) · smooth), smooth = 1/((1−cos half)·blend)
+            att = spot_attenuation(L, -wi);
+            if (att <= 0.0) return vec3(0.0);
+        }
+        float vis = 1.0;
+        if (shadowed) {
+            vis = type == LIGHT_POINT ? cube_visibility(int(L.params.y), p, geo_n)
+                                      : view_visibility(int(L.params.y), p, geo_n, wi);
+        }
+        // position.w = r² for Cycles' soft-falloff disk (E = I·cosθ/(d²+r²)), 0 for a point or sphere light.
+        return color * att * cosine / (d2 + L.position.w) * vis;
+    }
+    // Polygon light: one-sided lights shine along `direction` only.
+    vec3 from_light = p - L.position.xyz;
+    if (L.polygon.z < 0.5 && dot(from_light, L.direction.xyz) <= 0.0) return vec3(0.0);
+    float psa = polygon_projected_solid_angle(int(L.polygon.x), int(L.polygon.y), p, n);
+    if (psa <= 0.0) return vec3(0.0);
+    float vis = shadowed ? polygon_visibility(L, p, n, geo_n) : 1.0;
+    return color * psa * vis;
+}

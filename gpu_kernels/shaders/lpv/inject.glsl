@@ -1,0 +1,130 @@
+// LPV injection (seed 000 §3.3, seed 001): every RSM texel is a VPL of flux Φ = albedo × (irradiance × texel area);
+// its intensity (Φ/π)·max(0, n·ω) is projected on 2-band SH and added to the cell half a cell in front of it.
+// Accumulation is exact fixed point (integer atomics; no float atomics here), scaled by u_fixed_scale.
+// Because Φ carries the texel's world area, the result does not depend on the RSM resolution.
+// MODE_LIST: the same VPLs are written to a list instead (two slots per block; w = 1 marks a VPL), for the gathered
+// first bounce (lpv/gather.glsl).
+#include "common/lights.glsl"
+#include "common/light_eval.glsl"
+#include "lpv/fixed.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+uniform sampler2D u_rsm_position;
+uniform sampler2D u_rsm_normal;
+uniform sampler2D u_rsm_albedo;
+uniform ivec2 u_rsm_size;
+uniform int u_rsm_resolution;     // texels per RSM view side
+uniform int u_downsample;         // k: each k×k block of texels becomes one VPL (seed 001 N.5.2, intensity-aware)
+uniform vec3 u_grid_origin;
+uniform float u_grid_cell;
+uniform ivec3 u_grid_size;
+
+struct RsmView {
+    vec4 params;   // x: tan(half fov) (perspective) or 0; y: texel world size (orthographic); z: light; w: sample k
+    vec4 origin;   // xyz eye (perspective); w: 1 if orthographic
+    vec4 axis;     // xyz view axis; w: unused
+    vec4 right;    // xyz right vector of the view; w: unused (with axis and up: tangent-plane coordinates)
+};
+layout(std430, binding = 3) readonly buffer RsmViewBuffer { RsmView rsm_views[]; };
+#if defined(MODE_LIST)
+#include "common/structs.glsl"
+layout(std430, binding = 6) writeonly buffer VplList { Vpl vpls[]; };
+uniform int u_blocks_x;           // blocks per atlas row: the list slot of a block
+#endif
+
+// Solid angle of one texel of a perspective view with tan(half fov) m at tangent-plane point (x, y):
+// (2m/res)² / (1 + x² + y²)^(3/2).
+float texel_solid_angle(RsmView v, vec3 p) {
+    vec3 d = p - v.origin.xyz;
+    float z = dot(d, v.axis.xyz);
+    vec3 up = cross(v.right.xyz, v.axis.xyz);
+    float x = dot(d, v.right.xyz) / z, y = dot(d, up) / z;
+    float t = 2.0 * v.params.x / float(u_rsm_resolution);
+    return t * t / pow(1.0 + x * x + y * y, 1.5);
+}
+
+// Reflected flux of a surfel at p (normal n facing the light, albedo a) seen by RSM view v.
+vec3 vpl_flux(RsmView v, vec3 p, vec3 n, vec3 albedo) {
+    GpuLight L = lights[int(v.params.z)];
+    int type = int(L.color_type.w);
+    vec3 color = L.color_type.rgb;
+    if (type == LIGHT_SUN) {
+        // E·A = S·cosθ · t²/cosθ: the sun's flux through one texel of the orthographic map.
+        float cosine = dot(n, -L.direction.xyz);
+        return cosine > 0.0 ? albedo * color * v.params.y * v.params.y : vec3(0.0);
+    }
+    if (type == LIGHT_POINT || type == LIGHT_SPOT) {
+        // E·A = I·cosθ/(d²+r²) · d²Ω/cosθ = I·Ω·d²/(d²+r²): the light's flux into the texel's solid angle.
+        vec3 d = p - L.position.xyz;
+        float d2 = dot(d, d);
+        float att = type == LIGHT_SPOT ? spot_attenuation(L, normalize(d)) : 1.0;
+        return albedo * color * att * texel_solid_angle(v, p) * d2 / (d2 + L.position.w);
+    }
+    // Polygon light seen from sample point k: this RSM carries the share w_k/Σw_j of the exact irradiance, where
+    // w_j = cosθ_light,j · cosθ_surface,j / d_j² (the same weights as the shadow test). E_k·A simplifies to
+    // E · cosθ_light,k · Ω / Σw_j, with no division by the grazing cosine.
+    float psa = polygon_projected_solid_angle(int(L.polygon.x), int(L.polygon.y), p, n);
+    if (psa <= 0.0) return vec3(0.0);
+    int first = int(L.params.y), per = int(L.params.w), samples = int(L.params.z);
+    bool two_sided = L.polygon.z > 0.5;
+    float wsum = 0.0, cos_k = 0.0;
+    int k = int(v.params.w);
+    for (int j = 0; j < samples; ++j) {
+        vec3 o = shadow_views[first + j * per].origin.xyz;
+        vec3 d = p - o;
+        float d2 = max(dot(d, d), 1e-8);
+        vec3 w = d * inversesqrt(d2);
+        vec3 side_n = (two_sided && (j % 2 == 1)) ? -L.direction.xyz : L.direction.xyz;
+        float cl = max(dot(side_n, w), 0.0);
+        wsum += cl * max(dot(n, -w), 0.0) / d2;
+        if (j == k) cos_k = cl;
+    }
+    if (wsum <= 0.0) return vec3(0.0);
+    return albedo * color * psa * cos_k * texel_solid_angle(v, p) / wsum;
+}
+
+void main() {
+    // Intensity-aware clustering (seed 001 N.5.2): a k×k block of RSM texels becomes a VPL with the block's total
+    // flux, at the luminance-weighted mean position and normal — flux is kept exactly, and the VPL sits where the
+    // light is. A block can span two surfaces (a sunlit roof and, through its opening, the floor 3 m below): their
+    // mean would float in the air between them, so texels off the plane of the block's first lit texel (normal
+    // more than ~25° away, or more than half a cell from its plane) form a second VPL. Blocks never straddle views:
+    // tiles are multiples of 16 texels and k divides 16.
+    ivec2 block = ivec2(gl_GlobalInvocationID.xy);
+    if (any(greaterThanEqual(block * u_downsample, u_rsm_size))) return;
+    vec3 flux[2] = vec3[2](vec3(0.0), vec3(0.0));
+    vec3 position[2] = vec3[2](vec3(0.0), vec3(0.0));
+    vec3 normal[2] = vec3[2](vec3(0.0), vec3(0.0));
+    float weight[2] = float[2](0.0, 0.0);
+    bool has_plane = false;
+    vec3 plane_p = vec3(0.0), plane_n = vec3(0.0);
+    for (int j = 0; j < u_downsample; ++j)
+        for (int i = 0; i < u_downsample; ++i) {
+            ivec2 px = block * u_downsample + ivec2(i, j);
+            vec4 pos = texelFetch(u_rsm_position, px, 0);
+            if (pos.w < 0.5) continue;
+            vec3 n = normalize(texelFetch(u_rsm_normal, px, 0).xyz);
+            if (!has_plane) {
+                has_plane = true;
+                plane_p = pos.xyz;
+                plane_n = n;
+            }
+            int c = (dot(n, plane_n) > 0.9 && abs(dot(pos.xyz - plane_p, plane_n)) < 0.5 * u_grid_cell) ? 0 : 1;
+            vec3 f = vpl_flux(rsm_views[int(pos.w - 0.5)], pos.xyz, n, texelFetch(u_rsm_albedo, px, 0).rgb);
+            float w = dot(f, vec3(0.2126, 0.7152, 0.0722));  // Rec.709 luminance
+            flux[c] += f;
+            position[c] += w * pos.xyz;
+            normal[c] += w * n;
+            weight[c] += w;
+        }
+    for (int c = 0; c < 2; ++c) {
+        if (weight[c] <= 0.0 || dot(normal[c], normal[c]) == 0.0) continue;
+#if defined(MODE_LIST)
+        vpls[2 * (block.y * u_blocks_x + block.x) + c] = Vpl(vec4(position[c] / weight[c], 1.0),
+                                                              vec4(normalize(normal[c]), 0.0), vec4(flux[c], 0.0));
+#else
+        inject_lambertian(LpvGrid(u_grid_origin, u_grid_cell, u_grid_size), position[c] / weight[c],
+                          normalize(normal[c]), flux[c]);
+#endif
+    }
+}

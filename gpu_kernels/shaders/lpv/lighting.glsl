@@ -1,0 +1,127 @@
+// Diffuse Indirect from the LPV. Two estimators of irradiance E at a surface point with normal n:
+//
+// MODE_FLUX (default): the irradiance of the surface voxels near the point, from the flux fuzzy occlusion stopped
+// there (lpv/absorb.glsl): energy-exact, since irradiance × area summed over all surfaces is the absorbed flux.
+// The eight geometry-volume cells around the point are blended trilinearly, skipping empty ones, taking each
+// voxel's side that faces the same way as the point's normal.
+//
+// Otherwise, Kaplanyan's intensity lookup (seed 000 §3.3.1): irradiance at a G-buffer point is the accumulated intensity
+// distribution convolved with the clamped cosine about −n (light arriving at the surface travels along −n),
+// E = c · lobe(−n) / cell², where intensity / cell² is the radiance of a cell of cross-section cell² (the LPV stores
+// radiant intensity per cell). Volumes are sampled trilinearly half a cell in front of the surface, matching the
+// half-cell injection offset. Cascades: the finest cascade containing the point wins, blended into the next one
+// over its outer cells so the border does not show. Output is Cycles' Diffuse Indirect pass: E/π.
+#include "lpv/common.glsl"
+
+#define MAX_CASCADES 4
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(rgba32f, binding = 0) uniform writeonly image2D u_diffuse_indirect;
+uniform sampler2D u_position;
+uniform sampler2D u_normal;
+uniform sampler3D u_accum_r[MAX_CASCADES];
+uniform sampler3D u_accum_g[MAX_CASCADES];
+uniform sampler3D u_accum_b[MAX_CASCADES];
+uniform vec3 u_grid_origin[MAX_CASCADES];
+uniform float u_grid_cell[MAX_CASCADES];
+uniform ivec3 u_grid_size[MAX_CASCADES];
+uniform int u_cascades;
+uniform float u_blend_cells;     // width of the blend band at a cascade's border, in its cells
+uniform bool u_damping;          // seed 000's directional-derivative damping against leaks
+uniform ivec2 u_image_size;
+#if defined(MODE_FLUX)
+uniform sampler3D u_front[MAX_CASCADES];   // per fine voxel: rgb irradiance of its surfaces' front side, a = 1 if any
+uniform sampler3D u_back[MAX_CASCADES];
+uniform sampler3D u_voxel_normal[MAX_CASCADES];
+uniform vec3 u_fine_origin[MAX_CASCADES];
+uniform ivec3 u_fine_size[MAX_CASCADES];
+
+vec3 flux_irradiance(int cascade, vec3 p, vec3 n) {
+    vec3 t = (p - u_fine_origin[cascade]) / (0.5 * u_grid_cell[cascade]) - 0.5;
+    ivec3 base = ivec3(floor(t));
+    vec3 f = t - vec3(base);
+    vec3 sum = vec3(0.0), agreed = vec3(0.0);
+    float wsum = 0.0, agreed_w = 0.0;
+    for (int k = 0; k < 8; ++k) {
+        ivec3 o = ivec3(k & 1, (k >> 1) & 1, (k >> 2) & 1);
+        ivec3 G = base + o;
+        if (any(lessThan(G, ivec3(0))) || any(greaterThanEqual(G, u_fine_size[cascade]))) continue;
+        vec4 front = texelFetch(u_front[cascade], G, 0);
+        if (front.a <= 0.0) continue;
+        // Conservative voxelisation marks a surface lying near a voxel boundary in the voxels on both sides; the
+        // one behind it (centre more than half a voxel behind the point) holds this surface's back (a roof's
+        // sunlit top under its ceiling): skip it.
+        vec3 centre = u_fine_origin[cascade] + (vec3(G) + 0.5) * (0.5 * u_grid_cell[cascade]);
+        if (dot(centre - p, n) < -0.3 * u_grid_cell[cascade]) continue;
+        vec3 nv = texelFetch(u_voxel_normal[cascade], G, 0).xyz;
+        float w = (o.x == 1 ? f.x : 1.0 - f.x) * (o.y == 1 ? f.y : 1.0 - f.y) * (o.z == 1 ? f.z : 1.0 - f.z);
+        vec3 e = dot(n, nv) >= 0.0 ? front.rgb : texelFetch(u_back[cascade], G, 0).rgb;
+        // A voxel whose surfaces face another way (a corner voxel holding a wall and the ceiling has a diagonal
+        // mean normal, and the irradiance of that diagonal) says little about this surface: voxels within ~35° of
+        // the normal count fully, beyond ~45° not at all — unless none is that close.
+        float agree = abs(dot(n, nv)) * inversesqrt(max(dot(nv, nv), 1e-20));
+        float aw = w * clamp((agree - 0.7) / 0.12, 0.0, 1.0);
+        sum += w * e;
+        wsum += w;
+        agreed += aw * e;
+        agreed_w += aw;
+    }
+    if (agreed_w > 1e-3) return agreed / agreed_w;
+    return wsum > 0.0 ? sum / wsum : vec3(0.0);
+}
+#endif
+
+const float PI = 3.14159265358979;
+
+vec3 sample_cascade(int i, vec3 p, vec3 n) {
+    vec3 uvw = (p - u_grid_origin[i]) / (u_grid_cell[i] * vec3(u_grid_size[i]));
+    vec4 r = texture(u_accum_r[i], uvw), g = texture(u_accum_g[i], uvw), b = texture(u_accum_b[i], uvw);
+    if (u_damping) {
+        // Seed 000 §3.3.1: where the SH coefficients grow against the normal (∇_n c · c < 0), the light comes
+        // from behind the surface (a leak): damp it by how strongly the derivative disagrees.
+        vec3 step = n * 0.5 / vec3(u_grid_size[i]);
+        vec4 dc = texture(u_accum_r[i], uvw + step) - texture(u_accum_r[i], uvw - step)
+                + texture(u_accum_g[i], uvw + step) - texture(u_accum_g[i], uvw - step)
+                + texture(u_accum_b[i], uvw + step) - texture(u_accum_b[i], uvw - step);
+        vec4 c = r + g + b;
+        float agree = dot(c, dc);
+        if (agree < 0.0) {
+            float k = clamp(-agree / max(dot(c, c), 1e-20), 0.0, 1.0);
+            r *= 1.0 - k; g *= 1.0 - k; b *= 1.0 - k;
+        }
+    }
+    vec4 lobe = sh_clamped_cosine(-n);
+    return max(vec3(dot(r, lobe), dot(g, lobe), dot(b, lobe)), vec3(0.0)) / (u_grid_cell[i] * u_grid_cell[i]);
+}
+
+// 1 well inside cascade i, falling to 0 over the last u_blend_cells cells before its border.
+float cascade_weight(int i, vec3 p) {
+    vec3 g = (p - u_grid_origin[i]) / u_grid_cell[i];
+    vec3 edge = min(g, vec3(u_grid_size[i]) - g);
+    float inner = min(edge.x, min(edge.y, edge.z)) - 0.5;
+    return i == u_cascades - 1 ? float(inner >= -0.5) : clamp(inner / u_blend_cells, 0.0, 1.0);
+}
+
+void main() {
+    ivec2 px = ivec2(gl_GlobalInvocationID.xy);
+    if (any(greaterThanEqual(px, u_image_size))) return;
+    vec4 pos = texelFetch(u_position, px, 0);
+    if (pos.w < 0.5) {
+        imageStore(u_diffuse_indirect, px, vec4(0.0));
+        return;
+    }
+    vec3 n = normalize(texelFetch(u_normal, px, 0).xyz);
+    vec3 irradiance = vec3(0.0);
+    float remaining = 1.0;
+    for (int i = 0; i < u_cascades && remaining > 0.0; ++i) {
+        vec3 p = pos.xyz + n * 0.5 * u_grid_cell[i];
+        float w = cascade_weight(i, p) * remaining;
+        if (w <= 0.0) continue;
+#if defined(MODE_FLUX)
+        irradiance += w * flux_irradiance(i, pos.xyz, n);
+#else
+        irradiance += w * sample_cascade(i, p, n);
+#endif
+        remaining -= w;
+    }
+    imageStore(u_diffuse_indirect, px, vec4(irradiance / PI, 1.0));
+}

@@ -1,0 +1,84 @@
+// VCT radiance injection, compute half (the surface points are rasterised by vct/inject_raster.glsl).
+//
+// Per direction, not per side of the voxel normal: the voxelizer's normal is a mean of sign-canonicalised normals,
+// which says nothing about which side faces a room at an edge or corner voxel (floor + wall average to a diagonal
+// pointing into neither). So each of the six faces of a voxel (outward normal ±x, ±y, ±z) gets its own radiance
+// and coverage:
+//   L_g = Σ w·L / Σ w over the surface points whose lit side points through face g (vct/inject_raster.glsl),
+//   α_g = min(1, projected area onto the face's plane / cell²) from the voxelizer (the opacity of crossing the voxel
+//         along that axis; the same for both faces of an axis),
+//   c_g = Σ w·p / Σ w, where those surface points lie (the bounce pass gathers from there).
+// A face that has coverage but caught no fragment (a sliver thinner than the raster's pixels) falls back to one
+// evaluation at the face centre with the face normal: L_g = albedo·E(centre + n_g·cell/2, n_g)/π.
+// Emission is not injected: emissive triangles are lights (light_buffers.py), so E already carries their light,
+// and adding it again would count it twice (Cycles' Diffuse Indirect never holds emission).
+// MODE_CLEAR zeroes the accumulator; MODE_RESOLVE writes the faces: rgb = L_g, a = α_g, and centroids: xyz = c_g,
+// w = α_g (or the face centre and w = −α_g for a fallback face; w = 0 where the voxel has no surface).
+layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
+uniform ivec3 u_grid_size;
+
+#if defined(MODE_CLEAR)
+layout(r32ui, binding = 0) uniform writeonly uimage3D u_acc;
+void main() {
+    ivec3 v = ivec3(gl_GlobalInvocationID);
+    if (any(greaterThanEqual(v, u_grid_size))) return;
+    for (int g = 0; g < 6; ++g)
+        for (int c = 0; c < 8; ++c) imageStore(u_acc, ivec3(8 * v.x + c, v.y, g * u_grid_size.z + v.z), uvec4(0u));
+}
+#endif
+
+#if defined(MODE_RESOLVE)
+#include "common/lights.glsl"
+#include "common/light_eval.glsl"
+#include "direct/eval.glsl"
+uniform vec3 u_grid_origin;
+uniform float u_grid_cell;
+uniform int u_light_count;
+uniform sampler3D u_area;        // voxelize(): rgb projected areas (m²), a total area
+uniform sampler3D u_albedo;      // rgb mean diffuse albedo
+uniform usampler3D u_acc;        // vct/inject_raster.glsl's sums (float bits)
+// Six images per dispatch, not twelve: NVIDIA drivers allow 8 image units per stage (GL_MAX_IMAGE_UNITS, the
+// spec's minimum; Mesa allows 32), so vct.inject() runs this twice — faces, then centroids (WRITE_CENTROIDS).
+layout(rgba32f, binding = 0) uniform writeonly image3D u_out[6];       // +x, −x, +y, −y, +z, −z
+#include "vct/arrays.glsl"
+VCT_STORE6(store_out, u_out)
+
+float acc(int g, ivec3 v, int c) {
+    return uintBitsToFloat(texelFetch(u_acc, ivec3(8 * v.x + c, v.y, g * u_grid_size.z + v.z), 0).r);
+}
+
+void main() {
+    ivec3 v = ivec3(gl_GlobalInvocationID);
+    if (any(greaterThanEqual(v, u_grid_size))) return;
+    vec4 area = texelFetch(u_area, v, 0);
+    if (area.a <= 0.0) return;   // most voxels are empty, and the images start zeroed (vct._texture3d)
+    vec3 centre = u_grid_origin + (vec3(v) + 0.5) * u_grid_cell;
+    float cell2 = u_grid_cell * u_grid_cell;
+    for (int g = 0; g < 6; ++g) {
+        int axis = g >> 1;
+        vec3 n = vec3(0.0);
+        n[axis] = (g & 1) == 0 ? 1.0 : -1.0;
+        float alpha = area.a > 0.0 ? min(1.0, area[axis] / cell2) : 0.0;
+        vec3 radiance = vec3(0.0);
+        vec4 surface = vec4(centre + n * (0.5 * u_grid_cell), 0.0);
+        float w = acc(g, v, 3);
+        if (alpha > 0.0 && w > 0.0) {
+            radiance = vec3(acc(g, v, 0), acc(g, v, 1), acc(g, v, 2)) / w;
+            surface = vec4(vec3(acc(g, v, 4), acc(g, v, 5), acc(g, v, 6)) / w, alpha);
+        } else if (alpha > 0.0) {
+            // The centroid dispatch needs only where the face is, not its light.
+#if !defined(WRITE_CENTROIDS)
+            vec3 e = vec3(0.0);
+            for (int i = 0; i < u_light_count; ++i) e += light_irradiance(lights[i], surface.xyz, n, n);
+            radiance = texelFetch(u_albedo, v, 0).rgb * e / PI;
+#endif
+            surface.w = -alpha;
+        }
+#if defined(WRITE_CENTROIDS)
+        store_out(g, v, surface);
+#else
+        store_out(g, v, vec4(radiance, alpha));
+#endif
+    }
+}
+#endif

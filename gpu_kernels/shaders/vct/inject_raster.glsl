@@ -1,0 +1,121 @@
+// VCT radiance injection from real surface points (seed 004 §4.3 injects the lit surface points of the shadow map;
+// here every surface point is rasterised, lit or not, so shadowed faces get their 0 too).
+//
+// Geometry shader: each triangle is projected along the dominant axis of its normal (seed 004 §4.1.1, Algorithm 1)
+// onto a plane of VCT_SAMPLES pixels per voxel edge; every fragment is a point p on the surface, with the
+// triangle's geometric normal n and its material's diffuse albedo (base colour or texture × (1 − metallic), as the
+// voxelizer defines it).
+// Fragment shader: for each side s = ±n the outgoing radiance L_s = albedo·E(p, s·n)/π, E the shadowed irradiance
+// of every light exactly as the Diffuse Direct pass computes it (direct/eval.glsl). The side's light leaves the
+// voxel through the faces its normal points to: face g = (axis b, sign of s·n_b) receives weight
+// w = A·|n_b| (the fragment's area A projected onto that face's plane) and adds w·L_s, w and w·p to the face's
+// accumulator (vct/inject.glsl resolves the means). So a voxel holding a floor and a wall (an edge) gets the lit
+// wall's radiance on its ±x faces and the floor's on its ±z faces, wherever their surfaces lie in the voxel — the
+// voxel's mean normal could not say which side of such a voxel faces the room.
+// No float atomics in GL 4.5: the adds are compare-and-swap loops on the float's bits (r32ui).
+#if defined(VERTEX_SHADER)
+layout(location = 0) in vec3 in_position;
+layout(location = 1) in vec2 in_uv;
+out vec3 v_world;
+out vec2 v_uv;
+void main() {
+    v_world = in_position;
+    v_uv = in_uv;
+    gl_Position = vec4(0.0, 0.0, 0.0, 1.0);
+}
+#endif
+
+#if defined(GEOMETRY_SHADER)
+layout(triangles) in;
+layout(triangle_strip, max_vertices = 3) out;
+in vec3 v_world[];
+in vec2 v_uv[];
+uniform vec3 u_grid_origin;
+uniform float u_grid_cell;
+uniform float u_samples;       // pixels per voxel edge
+uniform vec2 u_viewport;       // framebuffer size in pixels
+out vec3 g_world;
+out vec2 g_uv;
+flat out vec3 g_normal;        // unit geometric normal
+flat out float g_area;         // surface area (m²) one fragment stands for: (cell/samples)² / |n_dominant|
+
+vec3 to_plane(vec3 p, int axis) { return axis == 0 ? p.yzx : (axis == 1 ? p.zxy : p); }
+
+void main() {
+    vec3 n = cross(v_world[1] - v_world[0], v_world[2] - v_world[0]);
+    float len = length(n);
+    if (!(len > 0.0)) return;
+    n /= len;
+    vec3 an = abs(n);
+    int axis = (an.x >= an.y && an.x >= an.z) ? 0 : (an.y >= an.z ? 1 : 2);
+    float px = u_grid_cell / u_samples;
+    for (int i = 0; i < 3; ++i) {
+        vec2 q = to_plane((v_world[i] - u_grid_origin) / px, axis).xy;
+        gl_Position = vec4(q / u_viewport * 2.0 - 1.0, 0.0, 1.0);
+        g_world = v_world[i];
+        g_uv = v_uv[i];
+        g_normal = n;
+        g_area = px * px / an[axis];
+        EmitVertex();
+    }
+    EndPrimitive();
+}
+#endif
+
+#if defined(FRAGMENT_SHADER)
+#include "common/lights.glsl"
+#include "common/light_eval.glsl"
+#include "direct/eval.glsl"
+uniform vec3 u_grid_origin;
+uniform float u_grid_cell;
+uniform ivec3 u_grid_size;
+uniform int u_light_count;
+uniform vec3 u_base_color;
+uniform float u_metallic;
+uniform bool u_use_texture;
+uniform sampler2D u_base_texture;
+in vec3 g_world;
+in vec2 g_uv;
+flat in vec3 g_normal;
+flat in float g_area;
+// Accumulator: channel c (0–2 Σw·L, 3 Σw, 4–6 Σw·p) of face g of voxel v at (8·v.x + c, v.y, g·nz + v.z).
+layout(r32ui, binding = 0) coherent uniform uimage3D u_acc;
+
+void add_float(ivec3 t, float x) {
+    if (x == 0.0) return;
+    uint expected = imageLoad(u_acc, t).r;
+    for (int i = 0; i < 256; ++i) {
+        uint actual = imageAtomicCompSwap(u_acc, t, expected, floatBitsToUint(uintBitsToFloat(expected) + x));
+        if (actual == expected) return;
+        expected = actual;
+    }
+}
+
+void main() {
+    vec3 p = g_world;
+    ivec3 v = ivec3(floor((p - u_grid_origin) / u_grid_cell));
+    if (any(lessThan(v, ivec3(0))) || any(greaterThanEqual(v, u_grid_size))) return;
+    vec3 color = u_use_texture ? textureLod(u_base_texture, g_uv, 0.0).rgb : u_base_color;
+    vec3 albedo = max(color, vec3(0.0)) * (1.0 - clamp(u_metallic, 0.0, 1.0));
+    for (int side = 0; side < 2; ++side) {
+        vec3 n = side == 0 ? g_normal : -g_normal;
+        vec3 e = vec3(0.0);
+        if (max(albedo.r, max(albedo.g, albedo.b)) > 0.0)
+            for (int i = 0; i < u_light_count; ++i) e += light_irradiance(lights[i], p, n, n);
+        vec3 radiance = albedo * e / PI;
+        for (int b = 0; b < 3; ++b) {
+            float w = g_area * abs(n[b]);
+            if (w <= 0.0) continue;
+            int g = 2 * b + (n[b] > 0.0 ? 0 : 1);
+            ivec3 t = ivec3(8 * v.x, v.y, g * u_grid_size.z + v.z);
+            add_float(t, w * radiance.r);
+            add_float(t + ivec3(1, 0, 0), w * radiance.g);
+            add_float(t + ivec3(2, 0, 0), w * radiance.b);
+            add_float(t + ivec3(3, 0, 0), w);
+            add_float(t + ivec3(4, 0, 0), w * p.x);
+            add_float(t + ivec3(5, 0, 0), w * p.y);
+            add_float(t + ivec3(6, 0, 0), w * p.z);
+        }
+    }
+}
+#endif

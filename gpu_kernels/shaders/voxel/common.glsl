@@ -1,0 +1,79 @@
+// Shared by voxel/raster.glsl and voxel/tess.glsl: material inputs and the fixed-point deposit of one
+// surface piece into the voxel accumulators (seed 004 §4.1: "we average the resulting color value using atomic
+// operations"). There are no float atomics in GL 4.5, so every quantity is summed as an integer: uint atomics
+// commute, so the sums, and the resolve that divides them, are bit-identical whatever order fragments arrive in.
+//
+// Accumulators: four r32ui 3D images of (4·nx, ny, nz); channel c of voxel (x, y, z) lives at (4x + c, y, z) so
+// one piece's adds touch neighbouring texels. Fixed point: 1 unit = 2^-scale_bits cell² of area, u_fixed_scale =
+// 2^scale_bits (voxelize.py picks the bits and re-runs with fewer if a voxel's total wraps, see u_flags).
+//   acc_area:     A|n.x|, A|n.y|, A|n.z|, A            (unsigned)
+//   acc_albedo:   A·albedo.rgb / u_albedo_max          (unsigned; .w unused)
+//   acc_normal:   A·n.xyz / 2                          (two's complement int in a uint; |Σ A n/2| < 2^31)
+//   acc_emission: A·emission.rgb / u_emission_max      (unsigned; .w unused)
+// Every channel is rounded from a value ≤ the area value, and rounding is monotone, so no channel can exceed
+// the total-area channel: checking that one channel for wrap-around guards them all.
+#pragma once
+
+uniform vec3 u_base_color;       // linear RGB, the diffuse albedo when no texture
+uniform float u_metallic;
+uniform vec3 u_emission;         // emission colour × strength
+uniform bool u_use_texture;
+uniform sampler2D u_base_texture;
+uniform float u_albedo_max;      // > 0: largest albedo component in the scene (normalises the albedo channel)
+uniform float u_emission_max;    // > 0: largest emission component in the scene
+uniform float u_fixed_scale;     // 2^scale_bits: fixed-point units per cell² of area
+
+layout(binding = 0, r32ui) uniform uimage3D u_acc_area;
+layout(binding = 1, r32ui) uniform uimage3D u_acc_albedo;
+layout(binding = 2, r32ui) uniform uimage3D u_acc_normal;
+layout(binding = 3, r32ui) uniform uimage3D u_acc_emission;
+layout(binding = 4, r32ui) uniform uimage3D u_flags;   // 1×1×1; bit 0 set when an area sum wrapped
+uniform ivec3 u_grid_size;            // grid size (nx, ny, nz)
+
+// Diffuse albedo of a voxel surfel: base colour (or texture) × (1 − metallic). The Principled
+// specular-layer share is view dependent (direct/gbuffer.glsl) and left out: a voxel has no single view direction.
+vec3 voxel_albedo(vec2 uv) {
+    vec3 color = u_use_texture ? textureLod(u_base_texture, uv, 0.0).rgb : u_base_color;
+    return max(color, vec3(0.0)) * (1.0 - clamp(u_metallic, 0.0, 1.0));
+}
+
+// Two-sided surfaces: flip a normal so its largest-magnitude component is positive (ties: first axis wins).
+vec3 canonical_normal(vec3 n) {
+    vec3 a = abs(n);
+    float lead = (a.x >= a.y && a.x >= a.z) ? n.x : (a.y >= a.z ? n.y : n.z);
+    return lead < 0.0 ? -n : n;
+}
+
+#define MIN_PIECE_UNITS 64.0
+uint fixed_round(float x) { return uint(x + 0.5); }   // x ≥ 0; monotone, so channel ≤ area channel holds
+
+// Add one surface piece of `area_cells` (area in cell² units) with unit normal `n` to voxel `v`.
+void deposit(ivec3 v, float area_cells, vec3 n, vec3 albedo) {
+    if (any(lessThan(v, ivec3(0))) || any(greaterThanEqual(v, u_grid_size)) || !(area_cells > 0.0)) return;
+    // A piece with positive area counts at least MIN_PIECE_UNITS, so occupancy (area > 0) never loses a voxel a
+    // surface really crosses and a voxel holding only slivers still gets a mean albedo/normal to 1/64; the bias
+    // is < 64 units (2^-18 cell² at 24 bits) per sliver piece, and none for pieces larger than that.
+    float a = max(area_cells * u_fixed_scale, MIN_PIECE_UNITS);
+    uint a_fix = fixed_round(a);
+    ivec3 t = ivec3(4 * v.x, v.y, v.z);
+    uint before = imageAtomicAdd(u_acc_area, t + ivec3(3, 0, 0), a_fix);
+    if (before > 0xFFFFFFFFu - a_fix) imageAtomicOr(u_flags, ivec3(0), 1u);
+    vec3 na = abs(n);
+    imageAtomicAdd(u_acc_area, t, fixed_round(a * na.x));
+    imageAtomicAdd(u_acc_area, t + ivec3(1, 0, 0), fixed_round(a * na.y));
+    imageAtomicAdd(u_acc_area, t + ivec3(2, 0, 0), fixed_round(a * na.z));
+    vec3 alb = a * min(albedo / u_albedo_max, vec3(1.0));
+    imageAtomicAdd(u_acc_albedo, t, fixed_round(alb.r));
+    imageAtomicAdd(u_acc_albedo, t + ivec3(1, 0, 0), fixed_round(alb.g));
+    imageAtomicAdd(u_acc_albedo, t + ivec3(2, 0, 0), fixed_round(alb.b));
+    vec3 c = canonical_normal(n) * (0.5 * a);
+    imageAtomicAdd(u_acc_normal, t, uint(int(round(c.x))));
+    imageAtomicAdd(u_acc_normal, t + ivec3(1, 0, 0), uint(int(round(c.y))));
+    imageAtomicAdd(u_acc_normal, t + ivec3(2, 0, 0), uint(int(round(c.z))));
+    if (u_emission_max > 0.0) {
+        vec3 e = a * min(max(u_emission, vec3(0.0)) / u_emission_max, vec3(1.0));
+        imageAtomicAdd(u_acc_emission, t, fixed_round(e.r));
+        imageAtomicAdd(u_acc_emission, t + ivec3(1, 0, 0), fixed_round(e.g));
+        imageAtomicAdd(u_acc_emission, t + ivec3(2, 0, 0), fixed_round(e.b));
+    }
+}

@@ -1,0 +1,68 @@
+// Compute passes around voxelisation (seed 004 §4.1): MODE_CLEAR zeroes the fixed-point accumulators,
+// MODE_RESOLVE turns their integer sums (voxel/common.glsl) into the RGBA32F volumes:
+//   area     rgb = Σ A|n.x|, Σ A|n.y|, Σ A|n.z| (m²), a = Σ A (m²)
+//   albedo   rgb = Σ A·albedo / Σ A, a = opacity = min(1, max projected area / cell²)
+//   normal   xyz = Σ A·n̂ / Σ A with n̂ sign-canonicalised (not renormalised: |mean| < 1 says normals disagree)
+//   emission rgb = Σ A·emission / Σ A
+// Pure integer→float arithmetic per voxel: deterministic.
+layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
+uniform ivec3 u_grid_size;
+
+#if defined(MODE_CLEAR)
+layout(binding = 0, r32ui) uniform writeonly uimage3D u_acc0;
+layout(binding = 1, r32ui) uniform writeonly uimage3D u_acc1;
+layout(binding = 2, r32ui) uniform writeonly uimage3D u_acc2;
+layout(binding = 3, r32ui) uniform writeonly uimage3D u_acc3;
+void main() {
+    ivec3 v = ivec3(gl_GlobalInvocationID);
+    if (any(greaterThanEqual(v, u_grid_size))) return;
+    for (int c = 0; c < 4; ++c) {
+        ivec3 t = ivec3(4 * v.x + c, v.y, v.z);
+        imageStore(u_acc0, t, uvec4(0u));
+        imageStore(u_acc1, t, uvec4(0u));
+        imageStore(u_acc2, t, uvec4(0u));
+        imageStore(u_acc3, t, uvec4(0u));
+    }
+}
+#endif
+
+#if defined(MODE_RESOLVE)
+uniform usampler3D u_acc_area;
+uniform usampler3D u_acc_albedo;
+uniform usampler3D u_acc_normal;
+uniform usampler3D u_acc_emission;
+uniform float u_unit_area;       // m² per fixed-point unit of area = cell² / 2^scale_bits
+uniform float u_cell_area;       // cell² (m²)
+uniform float u_albedo_max;
+uniform float u_emission_max;
+layout(binding = 0, rgba32f) uniform writeonly image3D u_area;
+layout(binding = 1, rgba32f) uniform writeonly image3D u_albedo;
+layout(binding = 2, rgba32f) uniform writeonly image3D u_normal;
+layout(binding = 3, rgba32f) uniform writeonly image3D u_emission;
+
+uvec4 fetch(usampler3D s, ivec3 v) {
+    ivec3 t = ivec3(4 * v.x, v.y, v.z);
+    return uvec4(texelFetch(s, t, 0).r, texelFetch(s, t + ivec3(1, 0, 0), 0).r,
+                 texelFetch(s, t + ivec3(2, 0, 0), 0).r, texelFetch(s, t + ivec3(3, 0, 0), 0).r);
+}
+
+void main() {
+    ivec3 v = ivec3(gl_GlobalInvocationID);
+    if (any(greaterThanEqual(v, u_grid_size))) return;
+    vec4 area_m2 = vec4(0.0), albedo = vec4(0.0), normal = vec4(0.0), emission = vec4(0.0);
+    uint total = texelFetch(u_acc_area, ivec3(4 * v.x + 3, v.y, v.z), 0).r;
+    if (total > 0u) {   // most voxels are empty: one fetch decides
+        uvec4 area = fetch(u_acc_area, v);
+        area_m2 = vec4(area) * u_unit_area;
+        float inv = 1.0 / float(area.w);   // the fixed-point unit cancels in every mean
+        albedo.rgb = vec3(fetch(u_acc_albedo, v).rgb) * (inv * u_albedo_max);
+        albedo.a = min(1.0, max(max(area_m2.x, area_m2.y), area_m2.z) / u_cell_area);
+        normal.xyz = vec3(ivec3(fetch(u_acc_normal, v).xyz)) * (2.0 * inv);
+        emission.rgb = vec3(fetch(u_acc_emission, v).rgb) * (inv * u_emission_max);
+    }
+    imageStore(u_area, v, area_m2);
+    imageStore(u_albedo, v, albedo);
+    imageStore(u_normal, v, normal);
+    imageStore(u_emission, v, emission);
+}
+#endif

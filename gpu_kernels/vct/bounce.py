@@ -1,0 +1,74 @@
+"""vct_bounce: bounces − 1 gathers at the voxel faces, each followed by a re-mip, and the rest of the bounces
+extrapolated as a geometric series (common/bounce_tail.py)."""
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from ..common.bounce_tail import tail_ratio, tail_sum
+from ..gl.bind import bind_samplers, dispatch, set_uniform, texture3d
+from .inject import face_flux
+from .mipmap import build_volumes
+from .settings import VctSettings
+from .trace import bind_cones
+from .volumes import ConeVolumes, Faces, bind_volumes
+
+
+def bounce(ctx, programs, vox, direct_faces: Faces, volumes: ConeVolumes, s: VctSettings, world) -> ConeVolumes:
+    """bounces − 1 gathers at the voxel faces (vct/bounce.glsl), each followed by a re-mip. Returns the volumes
+    the final gather reads (a non-owning view of `volumes` when bounces = 1); `bounce_stats` lists the flux the
+    faces carry after each bounce (bounce 1 = direct light reflected once)."""
+    stats = [{"bounce": 1, "flux": direct_faces.flux}]
+    gathered = s.bounces if not s.gathered_bounces else min(s.gathered_bounces, s.bounces)
+    if gathered <= 1:
+        return ConeVolumes(volumes.textures, volumes.grid, volumes.levels, volumes.anisotropic, owned=False,
+                           bounce_stats=stats, layers=volumes.layers, layers_owned=False)
+    grid = direct_faces.grid
+    faces = Faces([texture3d(ctx, grid.size, zero=True) for _ in range(6)], grid, direct_faces.levels)
+    prog = programs.compute("vct/bounce.glsl", {"MODE_ANISO": None} if volumes.anisotropic else None)
+    own, source, previous = None, volumes, None
+    for b in range(2, gathered + 1):
+        if b == gathered and gathered < s.bounces:  # the tail needs the last increment L_K − L_(K−1): keep L_(K−1)
+            previous = faces if b > 2 else direct_faces
+            if b > 2:
+                faces = Faces([texture3d(ctx, grid.size, zero=True) for _ in range(6)], grid, direct_faces.levels)
+        unit = bind_volumes(prog, source, 0)
+        unit = bind_samplers(prog, "u_direct", direct_faces.textures, unit)
+        unit = bind_samplers(prog, "u_centroid", direct_faces.centroids, unit)
+        bind_samplers(prog, "u_albedo", [vox.albedo], unit)
+        bind_cones(prog, grid, volumes.levels, replace(s, diffuse_cones=s.bounce_cones or s.diffuse_cones), world)
+        for i, t in enumerate(faces.textures):
+            t.bind_to_image(i, read=False, write=True)
+        dispatch(prog, grid.size)
+        ctx.memory_barrier()
+        own = source = build_volumes(ctx, programs, faces, volumes.anisotropic, into=own, layers=volumes.layers)
+        stats.append({"bounce": b, "flux": face_flux(ctx, programs, faces)[0]})
+    if previous is not None:
+        stats.append(extrapolate_tail(ctx, programs, faces, previous, stats, s.bounces))
+        if previous is not direct_faces:
+            previous.release()
+        own = build_volumes(ctx, programs, faces, volumes.anisotropic, into=own, layers=volumes.layers)
+    own.faces, own.bounce_stats = faces, stats
+    return own
+
+
+def extrapolate_tail(ctx, programs, faces: Faces, previous: Faces, stats: list, bounces: int) -> dict:
+    """Bounces K+1 … N without gathering them (common/bounce_tail.py): with B_k the flux bounce k added (B_1 =
+    the direct light's reflection), the faces get L_N = L_K + (L_K − L_(K−1)) · Σ_{j=1}^{N−K} r^j, in place on the
+    GPU (vct/bounce_tail.glsl). Coverage α is kept. Returns the statistics row of the tail."""
+    k = len(stats)  # bounces gathered so far (stats[i] = after bounce i + 1)
+    flux = [np.asarray(st["flux"], np.float64) for st in stats]
+    added = [flux[0]] + [flux[i] - flux[i - 1] for i in range(1, k)]
+    ratio = tail_ratio(added[-1], added[-2])
+    tail = tail_sum(ratio, bounces - k)
+    prog = programs.compute("vct/bounce_tail.glsl")
+    set_uniform(prog, "u_grid_size", tuple(int(v) for v in faces.grid.size))
+    set_uniform(prog, "u_tail", tuple(float(v) for v in tail))
+    for current, prev in zip(faces.textures, previous.textures):
+        bind_samplers(prog, "u_previous", [prev], 0)
+        current.bind_to_image(0, read=True, write=True)
+        dispatch(prog, faces.grid.size)
+        ctx.memory_barrier()
+    return {"bounce": bounces, "flux": [float(f) for f in flux[-1] + added[-1] * tail], "extrapolated": True,
+            "ratio": [float(r) for r in ratio]}

@@ -1,0 +1,107 @@
+"""VctSettings: every knob of the voxel cone tracer, validated, and the subsets each pass's cache key reads."""
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+from .cones import MAX_CONES, valid_cone_count
+
+MAX_SUBRAYS = 7  # vct/crossing.glsl keeps them in registers (a define per count)
+CONE_FIELDS = ("diffuse_cones", "diffuse_aperture", "max_distance", "step_multiplier", "start_offset")
+
+
+@dataclass(frozen=True)
+class VctSettings:
+    resolution: int = 64  # voxels along the longest axis of the scene (other axes padded, see vct_grid)
+    # A cap around the normal and one ring (5..9) or two rings (13, 16, … 31), cone_table. Default 9 with 7 sub-rays
+    # each (anisotropic volumes, vct/crossing.glsl), measured (64³, defaults otherwise, 160×120, against 2048-spp
+    # 8-bounce Cycles; Diffuse Indirect / Combined rel-L1, trace time 320×240 Cornell on llvmpipe):
+    #   9 cones × 7 sub-rays: Cornell 0.093 / 0.050, spot room 0.059 / 0.022, courtyard 0.080 / 0.059, 12 s;
+    #   9 × 5: 0.101 / 0.054, 0.062 / 0.023, 0.087 / 0.064, 7.5 s;  19 × 5: 0.080 / 0.045, 0.057 / 0.022, 0.072 /
+    #   0.053, 17 s;  19 × 7: 0.074 / 0.043, 0.058 / 0.022, 0.070 / 0.052, 25 s;  13 × 7: 0.093 / 0.051, 0.064 /
+    #   0.024, 0.077 / 0.057.
+    # (Before sub-rays, with the volumetric march: 19 cones 0.137 / 0.070, 0.131 / 0.048, 0.178 / 0.125, 2.3 s.)
+    diffuse_cones: int = 9
+    # Rays per diffuse cone in the per-pixel trace with anisotropic volumes (vct/crossing.glsl): the axis and
+    # subrays − 1 around it; each meets surfaces where it crosses them. 1 = the axis only (9 cones: 0.202 / 0.102,
+    # 0.099 / 0.036, 0.234 / 0.163). The trace's cost grows about linearly with it.
+    subrays: int = 7
+    # Cones per voxel face in the bounce gathers (vct_bounce); 0 = diffuse_cones. Bounced light is smooth, and
+    # these gathers are most of a multi-bounce frame's time. Default 6, measured against 9 (64³, defaults otherwise,
+    # Combined rel-L1 / bounce pass on llvmpipe): Cornell 0.092 vs 0.093 / 3.6 s vs 4.9 s, spot room 0.053 vs
+    # 0.058, courtyard 0.180 vs 0.181; 5 cones: 0.095 / 3.2 s, 0.058, 0.169.
+    bounce_cones: int = 6
+    diffuse_aperture: float = 0.0  # cone half-angle (degrees); 0 = derived: a cone of the region's solid angle
+    max_distance: float = 0.0  # metres a cone travels; 0 = until it leaves the grid (or is fully occluded)
+    # Indirect bounces in Diffuse Indirect (1 = light reflected once; Cycles' "1 bounce"). Default 8 like Cycles'
+    # default: with 1 bounce the interiors came out 0.48 (Cornell) / 0.73 (spot room) Diffuse Indirect rel-L1,
+    # most of it light missing.
+    bounces: int = 8
+    # Gather only this many bounces and extrapolate the rest up to `bounces` as a geometric series of the last
+    # increment (vct_cones._extrapolate_tail); 0 = gather every bounce. Each gathered bounce is a full cone pass
+    # over the voxels, the tail a few array operations. Default 4, measured against gathering all 8 (Combined
+    # rel-L1, 64³, 9 cones everywhere): Cornell 0.093 vs 0.092, spot room 0.058 vs 0.056, courtyard 0.181 vs 0.180
+    # in half the time (Cornell bounce pass 4.8 s vs 11.0 s on llvmpipe); gathering 3 was 0.098 / 0.057 / 0.198.
+    gathered_bounces: int = 4
+    # Step / sampled voxel size of the volumetric march (seed 004 listing 4.1 steps by the cone radius): the bounce
+    # gathers, the specular cone, isotropic volumes. The per-pixel sub-rays step one texel (vct/crossing.glsl).
+    step_multiplier: float = 0.5
+    start_offset: float = 1.5  # voxels along the normal (× ‖n‖₁): the trilinear support of the own texel
+    # One glossy cone per pixel along the reflected view direction → Glossy Indirect (vct_specular.py); pixels
+    # with no glossy closure or rougher than roughness_cutoff run no cone, so scenes without glossy materials pay
+    # one texture fetch per pixel.
+    specular_cone: bool = True
+    roughness_cutoff: float = 0.5  # specular cone skipped above this Principled roughness (Glossy Indirect = 0)
+    # Diffuse cones traced at (width/s) × (height/s) and brought back to full resolution by a depth- and
+    # normal-aware upsampling (seed 003, inferred lighting; vct_upsample.py). 1 = every pixel.
+    indirect_scale: int = 1
+    # Temporal accumulation (vct_temporal.py): each render turns the diffuse cone set about the normal by another
+    # angle and averages into a history, until this many frames are in; any change to the trace's inputs restarts
+    # it. 0 or 1 = off.
+    temporal_frames: int = 0
+    cone_rotation: float = 0.0  # degrees the diffuse cone set is turned about the normal (the jitter adds to it)
+    # Six directional volumes (Crassin) rather than one isotropic volume. Default on, measured: isotropic voxels
+    # show a wall's lit side from both sides, and with 4 bounces Cornell / courtyard Diffuse Indirect came out
+    # 1.8× / 5.1× as bright as 8-bounce Cycles (anisotropic: 0.96× / 0.98×).
+    anisotropic: bool = True
+    ao_distance: float = 0.0  # metres for voxel AO; 0 = AO is the sky visibility (cones leaving the grid)
+
+    def __post_init__(self):
+        checks = [
+            (16 <= self.resolution <= 512, f"resolution {self.resolution} out of range 16..512"),
+            (valid_cone_count(self.diffuse_cones), f"diffuse_cones {self.diffuse_cones} must be 5..9 or 13, 16, "
+             f"19, … {MAX_CONES - 1}"),
+            (isinstance(self.subrays, int) and 1 <= self.subrays <= MAX_SUBRAYS,
+             f"subrays {self.subrays} out of range 1..{MAX_SUBRAYS}"),
+            (self.bounce_cones == 0 or valid_cone_count(self.bounce_cones),
+             f"bounce_cones {self.bounce_cones} must be 0 (= diffuse_cones), 5..9 or 13, 16, 19, … {MAX_CONES - 1}"),
+            (self.diffuse_aperture == 0 or 0 < self.diffuse_aperture < 90,
+             f"diffuse_aperture {self.diffuse_aperture} must be 0 (derived) or in (0, 90) degrees"),
+            (self.max_distance >= 0 and math.isfinite(self.max_distance), "max_distance must be ≥ 0 (0 = unlimited)"),
+            (1 <= self.bounces <= 16, f"bounces {self.bounces} out of range 1..16"),
+            (self.gathered_bounces == 0 or 2 <= self.gathered_bounces <= 16,
+             f"gathered_bounces {self.gathered_bounces} must be 0 (gather all) or 2..16 (the tail needs a ratio)"),
+            (0.05 <= self.step_multiplier <= 2.0, f"step_multiplier {self.step_multiplier} out of range 0.05..2"),
+            (0.0 <= self.start_offset <= 8.0, f"start_offset {self.start_offset} out of range 0..8 voxels"),
+            (0.0 <= self.roughness_cutoff <= 1.0, f"roughness_cutoff {self.roughness_cutoff} out of range 0..1"),
+            (self.ao_distance >= 0 and math.isfinite(self.ao_distance), "ao_distance must be ≥ 0"),
+            (self.indirect_scale in (1, 2, 4), f"indirect_scale {self.indirect_scale} must be 1, 2 or 4"),
+            (0 <= self.temporal_frames <= 256, f"temporal_frames {self.temporal_frames} out of range 0..256"),
+            (math.isfinite(self.cone_rotation), "cone_rotation must be finite"),
+        ]
+        for ok, message in checks:
+            if not ok:
+                raise ValueError(message)
+
+    def key(self, kind: str) -> tuple:
+        """The settings a pass reads: 'bounce', 'trace' (diffuse cones per pixel, upsampling, accumulation) or
+        'specular' (resolution and anisotropy key the earlier passes)."""
+        extra = {"bounce": CONE_FIELDS + ("bounce_cones", "bounces", "gathered_bounces"),
+                 "trace": CONE_FIELDS + ("subrays", "ao_distance", "indirect_scale", "cone_rotation",
+                                         "temporal_frames"),
+                 "specular": ("max_distance", "step_multiplier", "start_offset", "specular_cone",
+                              "roughness_cutoff")}[kind]
+        d = asdict(self)
+        if kind == "bounce" and self.bounce_cones:  # the gathers at voxel faces use bounce_cones, not diffuse_cones
+            extra = tuple(name for name in extra if name != "diffuse_cones")
+        return tuple((name, d[name]) for name in extra)

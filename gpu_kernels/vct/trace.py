@@ -1,0 +1,111 @@
+"""vct_trace: the diffuse cones per G-buffer pixel (or per indirect_scale² block) → Diffuse Indirect and voxel
+AO (Crassin et al. 2011, cone tracing of the filtered volumes), the fix-up trace the upsampling asks for, the cone
+uniforms every cone pass shares, and read-backs for tests and statistics."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..common.grid import Grid
+from ..gl.bind import bind_grid, bind_samplers, dispatch, read_texture, set_uniform, write_uniform
+from .cones import MAX_CONES, cone_table, subray_radius
+from .settings import VctSettings
+from .volumes import ConeVolumes, Faces, bind_volumes
+
+
+def bind_cones(prog, grid: Grid, levels: int, s: VctSettings, world) -> None:
+    """Grid, cone table and trace settings of vct/common.glsl."""
+    dirs, weights, tans = cone_table(s.diffuse_cones, s.diffuse_aperture)
+    n = len(weights)
+    cones = np.zeros((MAX_CONES, 4), np.float32)
+    cones[:n, :3], cones[:n, 3] = dirs, weights
+    tan = np.zeros(MAX_CONES, np.float32)
+    tan[:n] = tans
+    write_uniform(prog, "u_cones", cones)
+    write_uniform(prog, "u_cone_tan", tan)
+    bind_grid(prog, grid, levels)
+    for name, value in (("u_cone_count", n), ("u_step", float(s.step_multiplier)),
+                        ("u_offset", float(s.start_offset)), ("u_max_distance", float(s.max_distance)),
+                        ("u_ao_distance", float(s.ao_distance)), ("u_world", tuple(float(c) for c in world[:3]))):
+        set_uniform(prog, name, value)
+
+
+def trace(ctx, programs, gbuffer, faces: Faces, volumes: ConeVolumes, s: VctSettings, world,
+          rotation_deg: float | None = None) -> dict:
+    """Diffuse cones per G-buffer pixel, or per indirect_scale² block (vct/trace.glsl): {'indirect': RGBA32F
+    texture of ceil(W/s) × ceil(H/s), rgb = Diffuse Indirect (irradiance/π), a = voxel AO; 'scale': s}. The cone
+    set is turned by `rotation_deg` about the normal (default s.cone_rotation)."""
+    scale = int(s.indirect_scale)
+    fw, fh = gbuffer.size
+    w, h = -(-fw // scale), -(-fh // scale)
+    out = ctx.texture((w, h), 4, dtype="f4")
+    prog = trace_program(programs, gbuffer, faces, volumes, s, world, rotation_deg, fixup=False)
+    set_uniform(prog, "u_image_size", (w, h))
+    set_uniform(prog, "u_scale", scale)
+    out.bind_to_image(0, read=False, write=True)
+    dispatch(prog, (w, h), local=8)
+    ctx.memory_barrier()
+    return {"indirect": out, "scale": scale}
+
+
+def fixup(ctx, programs, gbuffer, faces: Faces, volumes: ConeVolumes, s: VctSettings, world, texture,
+          rotation_deg: float | None = None) -> None:
+    """Trace, in place and at full resolution, the pixels of `texture` that vct/upsample.glsl marked (a < 0)."""
+    w, h = gbuffer.size
+    prog = trace_program(programs, gbuffer, faces, volumes, s, world, rotation_deg, fixup=True)
+    set_uniform(prog, "u_image_size", (w, h))
+    set_uniform(prog, "u_scale", 1)
+    texture.bind_to_image(0, read=True, write=True)
+    dispatch(prog, (w, h), local=8)
+    ctx.memory_barrier()
+
+
+def trace_program(programs, gbuffer, faces, volumes, s, world, rotation_deg, fixup: bool):
+    # Anisotropic volumes carry the layer volume the sub-rays need to find where surfaces lie (vct/crossing.glsl).
+    defines = {"MODE_ANISO": None, "MODE_CROSSING": None, "SUBRAYS": int(s.subrays)} if volumes.anisotropic else {}
+    if fixup:
+        defines["MODE_FIXUP"] = None
+    prog = programs.compute("vct/trace.glsl", defines or None)
+    unit = bind_volumes(prog, volumes, 0)
+    unit = bind_samplers(prog, "u_centroid", faces.centroids, unit)
+    for name in ("position", "normal", "geo_normal"):
+        unit = bind_samplers(prog, f"u_{name}", [gbuffer.textures[name]], unit)
+    bind_cones(prog, volumes.grid, volumes.levels, s, world)
+    if volumes.anisotropic:
+        set_uniform(prog, "u_subray_radius", subray_radius(s.subrays))
+    phi = math.radians(s.cone_rotation if rotation_deg is None else rotation_deg)
+    set_uniform(prog, "u_rotation", (math.cos(phi), math.sin(phi)))
+    set_uniform(prog, "u_full_size", tuple(int(n) for n in gbuffer.size))
+    return prog
+
+
+def read_ao(texture) -> np.ndarray:
+    """Voxel AO (H, W) from vct_trace's texture, rows top-to-bottom."""
+    return read_texture(texture, 4)[..., 3]
+
+
+def read_level(ctx, programs, texture, grid: Grid, level: int) -> np.ndarray:
+    """One mip level of a volume texture as (nz, ny, nx, 4) float32 (vct/mipmap.glsl MODE_READ)."""
+    nx, ny, nz = (int(n) >> level for n in grid.size)
+    out = ctx.buffer(reserve=nx * ny * nz * 16)
+    try:
+        prog = programs.compute("vct/mipmap.glsl", {"MODE_READ": None})
+        bind_samplers(prog, "u_src", [texture], 0)
+        set_uniform(prog, "u_dst_size", (nx, ny, nz))
+        set_uniform(prog, "u_level", level)
+        out.bind_to_storage_buffer(0)
+        dispatch(prog, (nx, ny, nz))
+        ctx.memory_barrier()
+        return np.frombuffer(out.read(), np.float32).reshape(nz, ny, nx, 4).copy()
+    finally:
+        out.release()
+
+
+def render_info(faces: Faces, volumes: ConeVolumes, s: VctSettings) -> dict:
+    """RenderResult.info for method 'vct': grid, levels, occupancy, flux per bounce."""
+    g = faces.grid
+    return {"grid": list(g.size), "cell": g.cell, "origin": list(g.origin), "levels": faces.levels,
+            "anisotropic": s.anisotropic, "occupied_voxels": faces.occupied, "faces_without_samples": faces.missed,
+            "cones": s.diffuse_cones,
+            "bounces": [dict(b) for b in (volumes.bounce_stats or [])]}

@@ -1,0 +1,327 @@
+"""Surface voxelisation on the GPU (seed 004 §4.1): area, albedo·opacity, normal and emission per voxel.
+
+Two methods, as compared in seed 004 §5.2.2 / Table 5.2:
+  * ``mode="raster"`` (§4.1.1): dominant-axis projection in a geometry shader, conservative coverage by
+    triangle dilation (or the pixel bounding box for slivers), and an *exact* area per voxel: each fragment clips
+    the original triangle to its pixel and to every voxel slab it crosses in depth (voxel/raster.glsl).
+  * ``mode="tessellation"`` (§4.1.2): the tessellator cuts each triangle into sub-triangles smaller than
+    1/supersample voxel; a geometry shader deposits each at its centroid, with its exact area. Triangles needing a
+    level above GL_MAX_TESS_GEN_LEVEL are split on the CPU first (`split_for_tessellation`).
+
+Averages are race-free and deterministic: every quantity is summed with integer ``imageAtomicAdd`` in fixed
+point (1 unit = 2^-scale_bits cell², default 2^-24: a voxel holds up to 256 cell² of surface; the shader flags a
+wrapped sum and `voxelize` re-runs with fewer bits), then a compute pass divides (voxel/resolve.glsl).
+
+Everything here runs on the GL thread that owns `ctx` (gpu_context.GpuWorker), including `VoxelVolumes.read`.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..common.grid import Grid
+from ..direct.geometry import bind_material
+from ..gl import preprocessor as spp
+from ..gl.bind import dispatch, set_uniform
+from ..scene import Scene
+
+MODES = ("raster", "tessellation")
+DEFAULT_SCALE_BITS = 24      # fixed point: 2^-24 cell² per unit, 2^8 = 256 cell² of surface per voxel before wrap
+MAX_TESS_LEVEL = 64          # GL_MAX_TESS_GEN_LEVEL is at least 64 everywhere (and exactly 64 on llvmpipe)
+TESS_VERTEX_BUDGET = 16384   # tessellated vertices per draw call (half of what llvmpipe handles, see below)
+DILATION_PX = 0.5 + 1.0 / 64.0   # half a pixel, plus slack for the rasteriser's 1/256-pixel vertex snapping
+VOLUME_NAMES = ("area", "albedo", "normal", "emission")
+
+
+@dataclass
+class VoxelVolumes:
+    """RGBA32F 3D textures of size grid.size (x, y, z); see voxel/resolve.glsl for the channels.
+
+    area: rgb = projected area onto the x/y/z planes (m²), a = surface area (m²);
+    albedo: rgb = area-weighted mean diffuse albedo, a = opacity = min(1, max projected area / cell²);
+    normal: xyz = area-weighted mean sign-canonicalised geometric normal (not renormalised), w = 0;
+    emission: rgb = area-weighted mean emitted radiance.
+    """
+    grid: Grid
+    area: object
+    albedo: object
+    normal: object
+    emission: object
+    mode: str
+    supersample: int
+    scale_bits: int          # fixed-point bits actually used
+    reruns: int = 0          # re-runs after a fixed-point overflow (0 normally)
+
+    def textures(self) -> dict:
+        return {name: getattr(self, name) for name in VOLUME_NAMES}
+
+    def read(self) -> dict:
+        """{name: (nz, ny, nx, 4) float32} — call on the GL thread (e.g. inside ``Engine().worker.call``)."""
+        nx, ny, nz = self.grid.size
+        return {name: np.frombuffer(tex.read(), np.float32).reshape(nz, ny, nx, 4).copy()
+                for name, tex in self.textures().items()}
+
+    def occupancy(self) -> np.ndarray:
+        """(nz, ny, nx) bool: voxels with surface area > 0 (GL thread)."""
+        nx, ny, nz = self.grid.size
+        return np.frombuffer(self.area.read(), np.float32).reshape(nz, ny, nx, 4)[..., 3] > 0.0
+
+    def release(self) -> None:
+        for tex in self.textures().values():
+            tex.release()
+
+
+def voxelize(ctx, programs, scene: Scene, geometry, textures: list, grid: Grid, mode: str = "raster",
+             supersample: int = 2, scale_bits: int = DEFAULT_SCALE_BITS) -> VoxelVolumes:
+    """Voxelise the scene's surfaces into `grid` (GL thread); returns new textures the caller releases.
+
+    `geometry`: direct.GeometryBuffers of `scene` (raster draws its VBO; tessellation uploads its own patch
+    buffer with oversized triangles split, so only the material ranges are read). `textures`: the list from
+    direct.upload_textures. `supersample`: raster — pixels per voxel edge, i.e. texture samples per voxel face
+    (areas are exact at any value); tessellation — sub-triangles per voxel edge. `scale_bits`: fixed-point
+    fraction bits (1 unit = 2^-bits cell²); lowered automatically, and reported, if a voxel's sum would wrap.
+    """
+    import moderngl
+
+    if mode not in MODES:
+        raise ValueError(f"unknown voxelisation mode {mode!r} (choose from {', '.join(MODES)})")
+    supersample = int(supersample)
+    if supersample < 1:
+        raise ValueError("supersample must be ≥ 1")
+    nx, ny, nz = grid.size
+    max_3d = int(ctx.info.get("GL_MAX_3D_TEXTURE_SIZE", 2048))
+    if 4 * nx > max_3d or ny > max_3d or nz > max_3d:
+        raise ValueError(f"grid {grid.size} too large: accumulators need 4·nx, ny, nz ≤ {max_3d}")
+    if mode == "raster" and max(grid.size) * supersample > 16384:
+        raise ValueError(f"grid {grid.size} × supersample {supersample} exceeds 16384 pixels")
+
+    used = sorted({m for m, _, _ in geometry.ranges})
+    albedo_max, emission_max = material_maxima(scene, used)
+    accs = [ctx.texture3d((4 * nx, ny, nz), 1, dtype="u4") for _ in range(4)]
+    flags = ctx.texture3d((1, 1, 1), 1, np.zeros(1, np.uint32).tobytes(), dtype="u4")
+    for t in accs + [flags]:
+        t.filter = (moderngl.NEAREST, moderngl.NEAREST)
+    patches = _tessellation_buffers(ctx, scene, grid, supersample) if mode == "tessellation" else None
+    try:
+        reruns = 0
+        while True:
+            _clear(ctx, programs, accs, grid)
+            flags.write(np.zeros(1, np.uint32).tobytes())
+            uniforms = {"u_grid_origin": grid.origin, "u_inv_cell": 1.0 / grid.cell, "u_grid_size": grid.size,
+                        "u_supersample": float(supersample), "u_albedo_max": albedo_max,
+                        "u_emission_max": emission_max, "u_fixed_scale": float(2.0 ** scale_bits)}
+            for unit, t in enumerate(accs + [flags]):
+                t.bind_to_image(unit, read=True, write=True)
+            if mode == "raster":
+                _draw_raster(ctx, programs, scene, geometry, textures, grid, supersample, uniforms)
+            else:
+                _draw_tessellated(ctx, programs, scene, patches, textures, uniforms)
+            ctx.memory_barrier()
+            overflow = np.frombuffer(flags.read(), np.uint32)[0] != 0
+            if not overflow or scale_bits <= 0:
+                break
+            # A voxel's area sum wrapped: retry with room for the whole scene's area in one voxel, then halve.
+            total_cells = float(scene_area(scene)) / grid.cell ** 2
+            safe = int(np.floor(np.log2(2.0 ** 31 / max(total_cells, 1e-30))))
+            scale_bits = max(0, min(scale_bits - 1, safe) if reruns == 0 else scale_bits - 2)
+            reruns += 1
+        volumes = _resolve(ctx, programs, accs, grid, scale_bits, albedo_max, emission_max)
+    finally:
+        for t in accs + [flags]:
+            t.release()
+        if patches is not None:
+            patches[0].release()
+    return VoxelVolumes(grid, *volumes, mode=mode, supersample=supersample, scale_bits=scale_bits, reruns=reruns)
+
+
+def scene_area(scene: Scene) -> float:
+    """Total triangle area of the scene (m², float64)."""
+    p = np.asarray(scene.positions, np.float64)
+    return float(0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1).sum())
+
+
+def material_maxima(scene: Scene, used) -> tuple[float, float]:
+    """Largest diffuse albedo and emission component over the materials in `used` (fixed-point normalisers)."""
+    albedo, emission = 0.0, 0.0
+    for i in used:
+        mat = scene.materials[i] if 0 <= i < len(scene.materials) else None
+        if mat is None:
+            albedo = max(albedo, 0.8)
+            continue
+        if 0 <= mat.base_color_texture < len(scene.textures):
+            color = float(np.max(scene.textures[mat.base_color_texture].pixels[..., :3], initial=0.0))
+        else:
+            color = max(float(c) for c in mat.base_color[:3])
+        albedo = max(albedo, color * (1.0 - min(max(float(mat.metallic), 0.0), 1.0)))
+        emission = max(emission, max(float(c) for c in mat.emission[:3]))
+    return (albedo if albedo > 0 else 1.0), (emission if emission > 0 else 0.0)
+
+
+def split_for_tessellation(positions: np.ndarray, cell: float, supersample: int,
+                           max_level: int = MAX_TESS_LEVEL) -> tuple[np.ndarray, np.ndarray]:
+    """Seed 004 §4.1.2 / §5.2.2 footnote 3: split triangles whose longest edge needs a tessellation level above
+    `max_level` (level = ceil(edge / cell · supersample)) into m² congruent sub-triangles (m = ceil(level /
+    max_level)), so none needs more than the hardware gives. Returns (source triangle index, barycentric corner
+    weights (S, 3, 3)) per output triangle, sources in input order; orientation is preserved."""
+    need = np.ceil(_longest_edge(positions) / float(cell) * supersample)  # the level the control shader wants
+    m = np.maximum(1, np.ceil(need / max_level)).astype(np.int64)
+    src, bary = [], []
+    for mm in np.unique(m):
+        idx = np.flatnonzero(m == mm)
+        lat = _lattice(int(mm))
+        src.append(np.repeat(idx, len(lat)))
+        bary.append(np.tile(lat, (len(idx), 1, 1)))
+    if not src:
+        return np.zeros(0, np.int64), np.zeros((0, 3, 3))
+    src, bary = np.concatenate(src), np.concatenate(bary)
+    order = np.argsort(src, kind="stable")
+    return src[order], bary[order]
+
+
+def _lattice(m: int) -> np.ndarray:
+    """Barycentric weights (m², 3 corners, 3 weights) of the regular m-subdivision of a triangle."""
+    tris = []
+    for i in range(m):
+        for j in range(m - i):
+            tris.append([(i, j), (i + 1, j), (i, j + 1)])
+            if i + j <= m - 2:
+                tris.append([(i + 1, j), (i + 1, j + 1), (i, j + 1)])
+    ij = np.asarray(tris, np.float64) / m                       # (m², 3, 2): weights of corners 1 and 2
+    return np.concatenate([1.0 - ij.sum(axis=2, keepdims=True), ij], axis=2)
+
+
+def tessellation_levels(positions: np.ndarray, cell: float, supersample: int) -> np.ndarray:
+    """Per triangle, the inner level voxel/tess.glsl's control shader will pick (max edge level, ≤ 64)."""
+    return np.clip(np.ceil(_longest_edge(positions) / float(cell) * supersample), 1, MAX_TESS_LEVEL)
+
+
+def _longest_edge(positions: np.ndarray) -> np.ndarray:
+    p = np.asarray(positions, np.float64).reshape(-1, 3, 3)
+    return np.linalg.norm(p[:, [1, 2, 0]] - p, axis=2).max(axis=1)
+
+
+def _tessellation_buffers(ctx, scene: Scene, grid: Grid, supersample: int):
+    """The patch VBO (same 11-float layout as direct.upload_geometry; normals unused) with oversized triangles
+    split, grouped by material, and draw ranges cut so no draw generates more than TESS_VERTEX_BUDGET vertices.
+
+    Why the cut: Mesa 22.3.6 llvmpipe's tessellator (measured here) hands the geometry shader sub-triangles made
+    of the wrong vertices once one draw generates more than about 32768 tessellated vertices (measured: identical
+    level-64 patches go wrong from the 12th in one draw; areas then come out several times too large).
+    """
+    src, bary = split_for_tessellation(scene.positions, grid.cell, supersample)
+    order = np.argsort(scene.material_index[src], kind="stable")
+    src, bary = src[order], bary[order]
+    pos = np.einsum("scw,swd->scd", bary, np.asarray(scene.positions, np.float64)[src])
+    uvs = np.einsum("scw,swd->scd", bary, np.asarray(scene.uvs, np.float64)[src])
+    data = np.zeros((len(src), 3, 11), np.float32)
+    data[..., 0:3], data[..., 6:8] = pos, uvs
+    # Upper bound on tessellated vertices per patch at level n (3169 measured at n = 64, 61 at n = 8).
+    n = tessellation_levels(pos, grid.cell, supersample)
+    cost = np.cumsum(0.78 * n * n + 3.0 * n + 3.0)
+    mats = scene.material_index[src]
+    ranges = []
+    starts = np.flatnonzero(np.r_[True, mats[1:] != mats[:-1]]) if len(mats) else np.zeros(0, int)
+    for s, e in zip(starts, np.r_[starts[1:], len(mats)]):
+        while s < e:
+            base = cost[s - 1] if s > 0 else 0.0
+            stop = max(s + 1, min(e, int(np.searchsorted(cost, base + TESS_VERTEX_BUDGET, side="right"))))
+            ranges.append((int(mats[s]), int(s) * 3, int(stop - s) * 3))
+            s = stop
+    return ctx.buffer(data.tobytes() or b"\0" * 44), ranges
+
+
+def _draw_raster(ctx, programs, scene, geometry, textures, grid, supersample, uniforms) -> None:
+    import moderngl
+
+    prog = programs.raster("voxel/raster.glsl")
+    side = max(grid.size) * supersample
+    for name, value in {**uniforms, "u_viewport": (float(side), float(side)), "u_dilation": DILATION_PX,
+                        "u_supersample_i": supersample}.items():
+        set_uniform(prog, name, value)
+    fbo = ctx.empty_framebuffer((side, side))
+    vao = ctx.vertex_array(prog, [(geometry.vbo, "3f 12x 2f 12x", "in_position", "in_uv")])
+    try:
+        fbo.use()
+        fbo.viewport = (0, 0, side, side)
+        ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
+        for mat_index, first, count in geometry.ranges:
+            bind_material(prog, scene, mat_index, textures)
+            vao.render(moderngl.TRIANGLES, vertices=count, first=first)
+    finally:
+        vao.release()
+        fbo.release()
+
+
+def _draw_tessellated(ctx, programs, scene, buffers, textures, uniforms) -> None:
+    import moderngl
+
+    vbo, ranges = buffers
+    prog = tessellation_program(programs, "voxel/tess.glsl")
+    for name, value in {**uniforms, "u_max_level": float(MAX_TESS_LEVEL)}.items():
+        set_uniform(prog, name, value)
+    vao = ctx.vertex_array(prog, [(vbo, "3f 12x 2f 12x", "in_position", "in_uv")])
+    fbo = ctx.empty_framebuffer((1, 1))   # draws need a complete framebuffer even with the rasteriser off
+    ctx.enable(moderngl.RASTERIZER_DISCARD)   # §4.1.2: no rasterisation; the geometry shader writes the voxels
+    try:
+        fbo.use()
+        ctx.patch_vertices = 3
+        for mat_index, first, count in ranges:
+            bind_material(prog, scene, mat_index, textures)
+            vao.render(moderngl.PATCHES, vertices=count, first=first)
+    finally:
+        ctx.disable(moderngl.RASTERIZER_DISCARD)
+        vao.release()
+        fbo.release()
+
+
+_TESS_STAGES = (("vertex_shader", "VERTEX_SHADER"), ("tess_control_shader", "TESS_CONTROL_SHADER"),
+                ("tess_evaluation_shader", "TESS_EVALUATION_SHADER"), ("geometry_shader", "GEOMETRY_SHADER"))
+
+
+def tessellation_program(programs, name: str, defines: dict | None = None):
+    """Compile a vertex + tessellation + geometry program (no fragment stage) from one .glsl file.
+
+    ProgramCache/shader_preprocessor only know vertex/fragment/geometry/compute stages, so the stage macro is
+    injected as an ordinary define (every stage then has the same header length, so one line map serves the
+    error report). The program is stored in the ProgramCache's table so `programs.release()` frees it.
+    """
+    table = getattr(programs, "_programs", None)
+    if table is None:
+        table = programs.__dict__.setdefault("_voxelize_programs", {})
+    key = ("tessellation", name, tuple(sorted((defines or {}).items())))
+    if key not in table:
+        stages = {arg: spp.load(name, {**(defines or {}), macro: None}) for arg, macro in _TESS_STAGES}
+        try:
+            table[key] = programs.ctx.program(**{arg: src.text for arg, src in stages.items()})
+        except Exception as exc:  # moderngl raises a plain Error carrying the driver log
+            raise spp.ShaderCompileError(spp.format_compile_error(str(exc), stages["vertex_shader"])) from None
+    return table[key]
+
+
+def _clear(ctx, programs, accs, grid) -> None:
+    prog = programs.compute("voxel/resolve.glsl", {"MODE_CLEAR": None})
+    for unit, t in enumerate(accs):
+        t.bind_to_image(unit, read=False, write=True)
+    set_uniform(prog, "u_grid_size", grid.size)
+    nx, ny, nz = grid.size
+    dispatch(prog, (nx, ny, nz))
+    ctx.memory_barrier()
+
+
+def _resolve(ctx, programs, accs, grid, scale_bits, albedo_max, emission_max) -> list:
+    prog = programs.compute("voxel/resolve.glsl", {"MODE_RESOLVE": None})
+    nx, ny, nz = grid.size
+    out = [ctx.texture3d((nx, ny, nz), 4, dtype="f4") for _ in VOLUME_NAMES]
+    for unit, (acc, name) in enumerate(zip(accs, ("u_acc_area", "u_acc_albedo", "u_acc_normal", "u_acc_emission"))):
+        acc.use(location=unit)
+        set_uniform(prog, name, unit)
+    for unit, tex in enumerate(out):
+        tex.bind_to_image(unit, read=False, write=True)
+    cell_area = grid.cell ** 2
+    for name, value in {"u_grid_size": grid.size, "u_unit_area": cell_area / 2.0 ** scale_bits, "u_cell_area": cell_area,
+                        "u_albedo_max": albedo_max, "u_emission_max": emission_max}.items():
+        set_uniform(prog, name, value)
+    dispatch(prog, (nx, ny, nz))
+    ctx.memory_barrier()
+    return out
