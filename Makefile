@@ -10,7 +10,7 @@ APT_PACKAGES := libx11-6 libxi6 libxfixes3 libxrender1 libxkbcommon0 libsm6 libi
                 libegl1 libegl-mesa0 libgl1-mesa-dri
 STAMP := $(VENV)/.setup-done
 
-.PHONY: setup demo test bench package clean system-libs
+.PHONY: setup demo test test-fast bench package clean system-libs
 
 setup: $(STAMP)
 
@@ -36,6 +36,10 @@ demo: setup
 
 test: setup
 	$(PY) -m pytest -q
+
+# The unit and GPU tests alone (no Blender, no Cycles): the quick loop while editing the core.
+test-fast: setup
+	$(PY) -m pytest -q -m "unit or gpu"
 
 # The committed benchmark (benchmarks/results/<renderer>/): example scenes at 160x120 against Cycles (± OIDN) and
 # EEVEE (its timed second render takes ~70 s per scene here), incremental updates, scaling; its quality table

@@ -115,7 +115,7 @@ def time_ours(engine, scene, settings, repeats: int):
     engine.render(scene, settings)  # compiles shaders, uploads
     runs = []
     for _ in range(repeats):
-        engine.worker.call(lambda ctx: engine._pipeline.cache.clear())
+        engine.clear_cache()
         start = time.perf_counter()
         result = engine.render(scene, settings)
         runs.append((time.perf_counter() - start, result))

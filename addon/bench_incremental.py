@@ -94,7 +94,7 @@ def measure_incremental(scene_resolution, method: str, repeats: int = 3) -> dict
 
     runs = []
     for _ in range(repeats):
-        engine.worker.call(lambda ctx: engine._pipeline.cache.clear())
+        engine.clear_cache()
         runs.append(_update(engine, settings, scene_resolution))
     record("full", runs)
     record("unchanged", [_update(engine, settings, scene_resolution) for _ in range(repeats)])

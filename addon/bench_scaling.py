@@ -53,7 +53,7 @@ def _frame_seconds(engine, scene, settings, repeats: int) -> float:
         repeats = 1
     runs = []
     for _ in range(repeats):
-        engine.worker.call(lambda ctx: engine._pipeline.cache.clear())
+        engine.clear_cache()
         start = time.perf_counter()
         engine.render(scene, settings)
         runs.append(time.perf_counter() - start)

@@ -71,7 +71,7 @@ def main():
             engine.render(scene, settings)  # warm-up: compiles shaders
             runs = []
             for _ in range(args.repeats):
-                engine.worker.call(lambda ctx: engine._pipeline.cache.clear())
+                engine.clear_cache()
                 start = time.perf_counter()
                 result = engine.render(scene, settings)
                 runs.append((time.perf_counter() - start, result))
@@ -94,7 +94,7 @@ def _timed(engine, scene, settings, repeats):
     engine.render(scene, settings)  # warm-up: compiles shaders
     runs = []
     for _ in range(repeats):
-        engine.worker.call(lambda ctx: engine._pipeline.cache.clear())
+        engine.clear_cache()
         start = time.perf_counter()
         result = engine.render(scene, settings)
         runs.append((time.perf_counter() - start, result))
@@ -146,10 +146,10 @@ def octree_table(args, engine, scenes, extract_scene, render_reference, Referenc
 def octree_errors(engine, settings, lpv_octree) -> str:
     """Seed 002 §4.1 after each iteration: re-run the propagation of the cached octree one step at a time."""
     def run(ctx):
-        cache = engine._pipeline.cache
+        cache = engine.pipeline.cache
         tree, geo = cache.entries["lpv_downsample"].value, cache.entries["lpv_octree_geometry"].value
         out = []
-        lpv_octree.propagate_levels(ctx, engine._pipeline.programs, tree, geo, settings,
+        lpv_octree.propagate_levels(ctx, engine.pipeline.programs, tree, geo, settings,
                                     per_step=lambda step: out.append((step, *lpv_octree.octree_errors(tree))))
         return out
     rows = engine.worker.call(run)

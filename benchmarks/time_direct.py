@@ -38,7 +38,7 @@ def main():
         cold = time.perf_counter() - start
         full, per_pass = [], []
         for _ in range(args.repeats):
-            engine.worker.call(lambda ctx: engine._pipeline.cache.clear())
+            engine.clear_cache()
             start = time.perf_counter()
             result = engine.render(scene, settings)
             full.append(time.perf_counter() - start)

@@ -88,7 +88,7 @@ def main():
                     engine.render(scene, settings)  # warm-up: compiles shaders
                     runs = []
                     for _ in range(args.repeats):
-                        engine.worker.call(lambda ctx: engine._pipeline.cache.clear())
+                        engine.clear_cache()
                         start = time.perf_counter()
                         result = engine.render(scene, settings)
                         runs.append((time.perf_counter() - start, result))

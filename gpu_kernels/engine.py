@@ -31,6 +31,16 @@ class Engine:
             self._pipeline = Pipeline(ctx)
         return self._pipeline.render(scene, settings)
 
+    @property
+    def pipeline(self) -> Pipeline | None:
+        """The pipeline (its pass cache and programs), None before the first render. GL objects it holds belong to
+        the worker thread: touch them only inside `worker.call`."""
+        return self._pipeline
+
+    def clear_cache(self) -> None:
+        """Drop every cached pass result (the next render runs every pass), on the GPU thread."""
+        self.worker.call(lambda ctx: self._pipeline.cache.clear() if self._pipeline else None)
+
     def gl_info(self) -> dict:
         return self.worker.call(lambda ctx: {"renderer": ctx.info["GL_RENDERER"], "version": ctx.version_code})
 

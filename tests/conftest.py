@@ -8,6 +8,16 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
+# The folder a test lives in is its marker: unit (pure Python), gpu (moderngl on llvmpipe), blender (bpy in a
+# subprocess), accuracy (against Cycles renders). `make test-fast` runs `-m "unit or gpu"`.
+MARKERS = ("unit", "gpu", "blender", "accuracy")
+
+
+def pytest_collection_modifyitems(items):
+    for item in items:
+        folder = Path(str(item.fspath)).parent.name
+        if folder in MARKERS:
+            item.add_marker(getattr(pytest.mark, folder))
 
 
 @pytest.fixture(scope="session")

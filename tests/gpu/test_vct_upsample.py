@@ -47,7 +47,7 @@ def _upsample(engine, scene, scale, field):
     """Render the G-buffer, fill the low-resolution texture with field(position (..., 3)) → (..., 4) at the pixels
     the trace would gather at, upsample. Returns (positions (H, W, 4), result (H, W, 4), marked), GL row order."""
     engine.render(scene, RenderSettings("none", W, H))
-    pipe = engine._pipeline
+    pipe = engine.pipeline
 
     def run(ctx):
         gbuffer = pipe.cache.entries["gbuffer"].value

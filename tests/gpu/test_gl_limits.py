@@ -73,7 +73,7 @@ def programs():
     scene = _room()
     for settings in SETTINGS:
         engine.render(scene, settings)
-    cache = engine._pipeline.programs
+    cache = engine.pipeline.programs
     return engine.worker.call(lambda ctx: {key: _units(p) for key, p in cache._programs.items()})
 
 

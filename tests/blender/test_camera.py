@@ -23,7 +23,7 @@ import pytest
 from bounce_gi.gpu_kernels.common import camera as cam
 from bounce_gi.gpu_kernels.scene import Camera
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 RTOL = 1e-5
 
 # id: (camera settings, width, height, pixel aspect x, pixel aspect y, location, rotation XYZ (deg))

@@ -181,8 +181,8 @@ def engine():
         eng.worker.shutdown()
         pytest.skip(str(exc))
     yield eng
-    if eng._pipeline is not None:
-        eng.worker.call(lambda ctx: eng._pipeline.release())
+    if eng.pipeline is not None:
+        eng.worker.call(lambda ctx: eng.pipeline.release())
     eng.worker.shutdown()
 
 

@@ -26,7 +26,7 @@ def engine():
 
 
 def _entry(engine, name, fn):
-    return engine.worker.call(lambda ctx: fn(engine._pipeline.cache.entries[name].value))
+    return engine.worker.call(lambda ctx: fn(engine.pipeline.cache.entries[name].value))
 
 
 def _floor_scene():
@@ -171,11 +171,11 @@ def test_octree_error_metric_is_zero_before_propagation_and_grows(engine):
     engine.render(_sphere_scene(), RenderSettings("lpv", 32, 24, lpv=settings))
 
     def run(ctx):
-        cache = engine._pipeline.cache
+        cache = engine.pipeline.cache
         tree, geo = cache.entries["lpv_downsample"].value, cache.entries["lpv_octree_geometry"].value
         scale = np.abs(lpv_octree.read_volumes(tree.levels[0].injected, tree.levels[0].grid)).max()
         out = []
-        lpv_octree.propagate_levels(ctx, engine._pipeline.programs, tree, geo, settings,
+        lpv_octree.propagate_levels(ctx, engine.pipeline.programs, tree, geo, settings,
                                     per_step=lambda step: out.append(lpv_octree.octree_errors(tree)))
         return scale, out
 

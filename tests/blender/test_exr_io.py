@@ -12,7 +12,7 @@ import pytest
 from bounce_gi.gpu_kernels.output import exr as exr_io
 
 oiio = pytest.importorskip("OpenImageIO")
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 
 def _passes(h=5, w=7, seed=0):

@@ -166,7 +166,7 @@ def test_a_lit_patch_in_a_dark_floor_matches_its_view_factor(engine, receiver):
 def _volumes(engine, scene, anisotropic):
     """Render once, then read every mip level of the vct_mipmap pass's volumes (GL thread)."""
     _render(engine, scene, anisotropic=anisotropic)
-    pipe = engine._pipeline
+    pipe = engine.pipeline
 
     def grab(ctx):
         vols = pipe.cache.entries["vct_mipmap"].value
@@ -285,7 +285,7 @@ def test_passes_rerun_only_downstream_and_ao_is_sky_visibility(engine, furnace):
     assert [b["bounce"] for b in r.info["bounces"]] == [1, 2]
     # A lone floor under a black sky: every cone leaves the grid, so AO (sky visibility) is 1 and nothing lights
     # the floor indirectly; a closed box: no cone should leave, AO should be 0.
-    pipe = engine._pipeline
+    pipe = engine.pipeline
     ao = engine.worker.call(lambda ctx: read_ao(pipe.cache.entries["vct_trace"].value["indirect"]))
     hit = r.passes["Depth"][..., 0] < 1e9
     assert float(ao[hit].min()) > 0.999 and float(r.passes["Diffuse Indirect"][hit].max()) < 1e-6

@@ -13,7 +13,7 @@ import tempfile
 
 import pytest
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 # name -> (mesh objects, lights, empties, emissive materials) in bpy.data
 EXPECTED_COUNTS = {

@@ -10,7 +10,7 @@ import subprocess
 import sys
 import textwrap
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 # Prepended to every case: `bounce_gi` is this checkout, its UI registered.
 PRELUDE = """

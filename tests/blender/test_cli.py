@@ -14,7 +14,7 @@ import textwrap
 import numpy as np
 import pytest
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SCRIPT = os.path.join(os.path.dirname(sys.executable), "bounce-gi")
 CLI = [SCRIPT] if os.path.exists(SCRIPT) else [sys.executable, "-m", "bounce_gi.addon.cli"]
 PASSES = {"Combined", "Diffuse Direct", "Diffuse Indirect", "Diffuse Color", "Glossy Indirect", "Glossy Color", "Emission", "AO", "Normal", "Position",

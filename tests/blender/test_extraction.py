@@ -15,7 +15,7 @@ import traceback
 import numpy as np
 import pytest
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 # Known construction of the `extraction` example (examples/scenes.py::extraction), in triangles.
 CUBE_QUADS = 6
