@@ -158,7 +158,7 @@ def bench_scene(path, quick, res, tmp, progress, eevee=True) -> dict:
     from ..gpu_kernels.engine import get_engine
     from .bench_peers import render_peers
     from .cli import load_scene
-    from .cycles_reference import ReferenceSettings, render_reference
+    from .reference.cycles import ReferenceSettings, render_reference
 
     resolution = tuple(res) if res else (QUICK_RES if quick else None)
     scene = load_scene(path, resolution)

@@ -2,7 +2,7 @@
 OpenImageDenoise, and EEVEE at its defaults (its first render compiles shaders, so the second is timed).
 
 Peer times are bpy.ops.render.render wall time: scene sync, render and writing the EXR, as a user would wait.
-Settings are changed inside `_saved`, so the open scene is left as it was.
+Settings are changed inside `saved_attributes`, so the open scene is left as it was.
 """
 from __future__ import annotations
 
@@ -33,7 +33,7 @@ def render_peers(ref, mask, width, height, quick, progress, tmp, eevee=True) -> 
     import bpy
 
     from ..gpu_kernels.output import metrics
-    from .cycles_reference import ReferenceSettings, _configure, _saved, _settings_to_save
+    from .reference.cycles import ReferenceSettings, configure_cycles, saved_attributes, settings_to_save
 
     scene, view_layer = bpy.context.scene, bpy.context.view_layer
     peers, warnings = [], []
@@ -41,9 +41,9 @@ def render_peers(ref, mask, width, height, quick, progress, tmp, eevee=True) -> 
     def score(passes):
         return _finite(metrics.rel_l1(passes["Combined"], ref.passes["Combined"], mask))
 
-    with _saved(_settings_to_save(scene, view_layer) + [(scene.cycles, "denoiser")]):
+    with saved_attributes(settings_to_save(scene, view_layer) + [(scene.cycles, "denoiser")]):
         path = os.path.join(tmp, "peer.exr")
-        _configure(scene, view_layer, ReferenceSettings(width, height, samples=1), 3, path)
+        configure_cycles(scene, view_layer, ReferenceSettings(width, height, samples=1), 3, path)
         try:
             _render_exr(bpy, path)  # warm-up: kernel load, first scene sync
         except Exception as exc:  # noqa: BLE001 — a peer failing must not end the benchmark
@@ -55,7 +55,7 @@ def render_peers(ref, mask, width, height, quick, progress, tmp, eevee=True) -> 
                 progress(f"bench: Cycles {spp} spp" + (" + OIDN" if denoise else ""))
                 try:
                     # seed 3: independent of the reference's seeds 1 and 2
-                    _configure(scene, view_layer, ReferenceSettings(width, height, samples=spp), 3, path)
+                    configure_cycles(scene, view_layer, ReferenceSettings(width, height, samples=spp), 3, path)
                     scene.cycles.use_denoising = denoise
                     if denoise:
                         scene.cycles.denoiser = "OPENIMAGEDENOISE"
@@ -69,7 +69,7 @@ def render_peers(ref, mask, width, height, quick, progress, tmp, eevee=True) -> 
 
 
 def render_eevee(bpy, width, height, skip, progress, tmp, score, warnings) -> dict:
-    from .cycles_reference import _saved
+    from .reference.cycles import saved_attributes
 
     scene = bpy.context.scene
     r = scene.render
@@ -89,7 +89,7 @@ def render_eevee(bpy, width, height, skip, progress, tmp, score, warnings) -> di
     attrs = [(r, a) for a in ("engine", "resolution_x", "resolution_y", "resolution_percentage", "use_border",
                               "film_transparent", "filepath")]
     attrs += [(im, "color_depth"), (im, "file_format")] + ([(im, "media_type")] if hasattr(im, "media_type") else [])
-    with _saved(attrs):
+    with saved_attributes(attrs):
         r.engine = name
         r.resolution_x, r.resolution_y, r.resolution_percentage = width, height, 100
         r.use_border, r.film_transparent = False, False

@@ -219,7 +219,7 @@ def compare(scene, method: str, samples: int, bounces: int = 8, progress=_progre
     import numpy as np
 
     from ..gpu_kernels.output import metrics
-    from .cycles_reference import ReferenceSettings, render_reference
+    from .reference.cycles import ReferenceSettings, render_reference
 
     result = render_ours(scene, method, lpv_options, vct_settings)
     ref_settings = ReferenceSettings(scene.resolution[0], scene.resolution[1], samples=samples, bounces=bounces)

@@ -38,7 +38,7 @@ OCTREE_PASSES = ("lpv_octree_geometry", "lpv_inject", "lpv_downsample", "lpv_pro
 def export(out_dir, samples):
     import bpy
 
-    from bounce_gi.addon.cycles_reference import ReferenceSettings, render_reference
+    from bounce_gi.addon.reference.cycles import ReferenceSettings, render_reference
     from bounce_gi.addon.extract import extract_scene
     from examples import scenes
 

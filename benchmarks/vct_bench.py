@@ -53,7 +53,7 @@ def main():
     import bpy
     import numpy as np
 
-    from bounce_gi.addon.cycles_reference import ReferenceSettings, render_reference
+    from bounce_gi.addon.reference.cycles import ReferenceSettings, render_reference
     from bounce_gi.addon.extract import extract_scene
     from bounce_gi.gpu_kernels.output import metrics
     from bounce_gi.gpu_kernels.engine import Engine

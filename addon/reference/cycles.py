@@ -17,8 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..gpu_kernels.output import exr as exr_io
-from ..gpu_kernels.output import metrics
+from ...gpu_kernels.output import exr as exr_io
+from ...gpu_kernels.output import metrics
 
 PASS_FLAGS = ("use_pass_diffuse_direct", "use_pass_diffuse_indirect", "use_pass_diffuse_color", "use_pass_emit",
               "use_pass_normal", "use_pass_z", "use_pass_position", "use_pass_glossy_direct",
@@ -63,7 +63,7 @@ def cache_key(scene_hash: str, settings: ReferenceSettings) -> str:
 
 
 @contextmanager
-def _saved(objects_attrs):
+def saved_attributes(objects_attrs):
     """Remember (object, attribute) values and put them back afterwards."""
     saved = []
     for obj, attr in objects_attrs:
@@ -81,7 +81,7 @@ def _saved(objects_attrs):
                 pass
 
 
-def _configure(scene, view_layer, settings: ReferenceSettings, seed: int, path: str) -> None:
+def configure_cycles(scene, view_layer, settings: ReferenceSettings, seed: int, path: str) -> None:
     c, r = scene.cycles, scene.render
     r.engine = "CYCLES"
     c.device = "CPU"
@@ -117,7 +117,7 @@ def _configure(scene, view_layer, settings: ReferenceSettings, seed: int, path: 
     r.filepath = path
 
 
-def _settings_to_save(scene, view_layer):
+def settings_to_save(scene, view_layer):
     c, r = scene.cycles, scene.render
     attrs = [(r, a) for a in ("engine", "resolution_x", "resolution_y", "resolution_percentage", "use_border",
                               "film_transparent", "filepath")]
@@ -151,13 +151,13 @@ def render_reference(scene_hash: str, settings: ReferenceSettings, progress=None
     scene = bpy.context.scene
     view_layer = bpy.context.view_layer
     seeds, seconds = [], 0.0
-    with tempfile.TemporaryDirectory(prefix="bounce-gi-ref-") as tmp, _saved(_settings_to_save(scene, view_layer)):
+    with tempfile.TemporaryDirectory(prefix="bounce-gi-ref-") as tmp, saved_attributes(settings_to_save(scene, view_layer)):
         for i, seed in enumerate(settings.seeds):
             if progress:
                 progress(f"Cycles reference: seed {seed} ({i + 1}/{len(settings.seeds)}), "
                          f"{settings.samples} samples at {settings.width}x{settings.height}")
             out = os.path.join(tmp, f"seed{seed}.exr")
-            _configure(scene, view_layer, settings, seed, out)
+            configure_cycles(scene, view_layer, settings, seed, out)
             start = time.perf_counter()
             bpy.ops.render.render(write_still=True)
             seconds += time.perf_counter() - start

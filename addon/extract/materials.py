@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..gpu_kernels.scene import Material, Texture
+from ...gpu_kernels.scene import Material, Texture
 
 
 def _output_surface_node(tree):

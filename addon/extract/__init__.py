@@ -9,7 +9,7 @@ import math
 
 import numpy as np
 
-from ..gpu_kernels.scene import Camera, Light, Material, Scene, Texture, World
+from ...gpu_kernels.scene import Camera, Light, Material, Scene, Texture, World
 from . import materials as mat_reader
 
 GEOMETRY_TYPES = {"MESH", "CURVE", "SURFACE", "FONT", "META", "CURVES"}

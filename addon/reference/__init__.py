@@ -1,0 +1,1 @@
+"""Ground truth from Cycles: references rendered with settings that make comparisons exact, and cached."""
