@@ -191,58 +191,81 @@ def emissive_triangles(scene: Scene) -> tuple[np.ndarray, np.ndarray]:
     return idx[order][keep], radiance[order][keep]
 
 
-def build_light_buffers(scene: Scene, settings: ShadowSettings | None = None) -> LightBuffers:
-    """Pack every light (and emissive triangle) into GPU records and list the shadow views they sample."""
-    s = settings or ShadowSettings()
-    records, views, polys, warnings, view_lights = [], [], [], [], []
+class _Records:
+    """The light records, shadow views and polygon vertices being packed, in the order the shaders read them."""
 
-    def add(type_, color, position=(0, 0, 0), radius=0.0, direction=(0, 0, -1), cos_half=0.0, smooth=0.0,
+    def __init__(self):
+        self.records, self.views, self.polys, self.warnings, self.view_lights = [], [], [], [], []
+
+    def add(self, type_, color, position=(0, 0, 0), radius=0.0, direction=(0, 0, -1), cos_half=0.0, smooth=0.0,
             light_views=(), samples=0, per=0, poly=None, two_sided=False):
         rec = np.zeros((), LIGHT_DTYPE)
         rec["color_type"] = (*color, type_)
         rec["position"] = (*position, radius)
         rec["direction"] = (*direction, cos_half)
-        rec["params"] = (smooth, len(views), samples, per)
+        rec["params"] = (smooth, len(self.views), samples, per)
         if poly is not None:
-            rec["polygon"] = (sum(len(p) for p in polys), len(poly), 1.0 if two_sided else 0.0, 0)
-            polys.append(np.asarray(poly, np.float64))
-        views.extend(light_views)
-        view_lights.extend([len(records)] * len(light_views))
-        records.append(rec)
+            rec["polygon"] = (sum(len(p) for p in self.polys), len(poly), 1.0 if two_sided else 0.0, 0)
+            self.polys.append(np.asarray(poly, np.float64))
+        self.views.extend(light_views)
+        self.view_lights.extend([len(self.records)] * len(light_views))
+        self.records.append(rec)
 
+    def finish(self) -> LightBuffers:
+        lights = np.array(self.records, LIGHT_DTYPE) if self.records else np.zeros(0, LIGHT_DTYPE)
+        vertices = np.concatenate(self.polys) if self.polys else np.zeros((0, 3))
+        vertices = np.concatenate([vertices, np.ones((len(vertices), 1))], axis=1).astype(np.float32)
+        return LightBuffers(lights, self.views, vertices, self.warnings, self.view_lights)
+
+
+def build_light_buffers(scene: Scene, settings: ShadowSettings | None = None) -> LightBuffers:
+    """Pack every light (and emissive triangle) into GPU records and list the shadow views they sample."""
+    s = settings or ShadowSettings()
+    out = _Records()
     for light in scene.lights:
-        color = _color(light)
-        if light.type == "SUN":
-            v = [sun_view(scene, light, s.sun_resolution)] if light.cast_shadow else []
-            add(LIGHT_SUN, color * light.power, direction=light.direction, light_views=v, samples=len(v), per=1)
-        elif light.type in ("POINT", "SPOT"):
-            intensity = color * light.power / (4 * math.pi)
-            near, far = _near_far(scene, light.position)
-            if light.type == "POINT":
-                v = cube_views(light.position, s.cube_resolution, near, far) if light.cast_shadow else []
-                add(LIGHT_POINT, intensity, light.position, _falloff_radius2(light), light_views=v,
-                    samples=1 if v else 0, per=6)
-            else:
-                cos_half = math.cos(light.spot_size / 2)
-                smooth = 1.0 / ((1.0 - cos_half) * light.spot_blend) if light.spot_blend > 0 and cos_half < 1 else 0.0
-                v = [spot_view(scene, light, s.spot_resolution, near, far)] if light.cast_shadow else []
-                add(LIGHT_SPOT, intensity, light.position, _falloff_radius2(light), light.direction, cos_half, smooth,
-                    light_views=v, samples=1 if v else 0, per=1)
-        elif light.type == "AREA":
-            poly, area = area_polygon(light)
-            if area <= 0:
-                warnings.append(f"area light '{light.name}' has zero size and is ignored")
-                continue
-            radiance = color * light.power / (math.pi * area)
-            v = []
-            pts = area_sample_points(light, s.area_samples) if light.cast_shadow else []
-            for point in pts:
-                v.extend(cube_views(point, s.sample_cube_resolution, *_near_far(scene, point)))
-            add(LIGHT_POLYGON, radiance, poly.mean(axis=0), 0.0, light.direction, light_views=v,
-                samples=len(pts), per=6, poly=poly)
-        else:
-            warnings.append(f"light '{light.name}' of type {light.type} is not supported and is ignored")
+        _add_lamp(out, scene, light, s)
+    _add_emissive(out, scene, s)
+    return out.finish()
 
+
+def _add_lamp(out: _Records, scene: Scene, light: Light, s: ShadowSettings) -> None:
+    """One Blender light: its record and its shadow views (sun: one orthographic map, point: a cube, spot: one
+    perspective map, area: a cube per shadow sample point)."""
+    color = _color(light)
+    if light.type == "SUN":
+        v = [sun_view(scene, light, s.sun_resolution)] if light.cast_shadow else []
+        out.add(LIGHT_SUN, color * light.power, direction=light.direction, light_views=v, samples=len(v), per=1)
+    elif light.type in ("POINT", "SPOT"):
+        intensity = color * light.power / (4 * math.pi)
+        near, far = _near_far(scene, light.position)
+        if light.type == "POINT":
+            v = cube_views(light.position, s.cube_resolution, near, far) if light.cast_shadow else []
+            out.add(LIGHT_POINT, intensity, light.position, _falloff_radius2(light), light_views=v,
+                    samples=1 if v else 0, per=6)
+        else:
+            cos_half = math.cos(light.spot_size / 2)
+            smooth = 1.0 / ((1.0 - cos_half) * light.spot_blend) if light.spot_blend > 0 and cos_half < 1 else 0.0
+            v = [spot_view(scene, light, s.spot_resolution, near, far)] if light.cast_shadow else []
+            out.add(LIGHT_SPOT, intensity, light.position, _falloff_radius2(light), light.direction, cos_half,
+                    smooth, light_views=v, samples=1 if v else 0, per=1)
+    elif light.type == "AREA":
+        poly, area = area_polygon(light)
+        if area <= 0:
+            out.warnings.append(f"area light '{light.name}' has zero size and is ignored")
+            return
+        radiance = color * light.power / (math.pi * area)
+        v = []
+        pts = area_sample_points(light, s.area_samples) if light.cast_shadow else []
+        for point in pts:
+            v.extend(cube_views(point, s.sample_cube_resolution, *_near_far(scene, point)))
+        out.add(LIGHT_POLYGON, radiance, poly.mean(axis=0), 0.0, light.direction, light_views=v,
+                samples=len(pts), per=6, poly=poly)
+    else:
+        out.warnings.append(f"light '{light.name}' of type {light.type} is not supported and is ignored")
+
+
+def _add_emissive(out: _Records, scene: Scene, s: ShadowSettings) -> None:
+    """Every emissive triangle as a two-sided polygon light; the brightest max_shadowed_emissive are shadowed."""
     tri_idx, radiance = emissive_triangles(scene)
     shadowed = min(len(tri_idx), s.max_shadowed_emissive)
     # Few emitters get 4 shadow points per side (centroids of the midpoint subdivision) for softer, truer
@@ -263,16 +286,11 @@ def build_light_buffers(scene: Scene, settings: ShadowSettings | None = None) ->
                     p = point + side * eps * normal
                     v.extend(cube_views(p, s.sample_cube_resolution, *_near_far(scene, p)))
                     samples += 1
-        add(LIGHT_POLYGON, rad, centroid, 0.0, normal, light_views=v, samples=samples, per=6, poly=tri,
-            two_sided=True)
+        out.add(LIGHT_POLYGON, rad, centroid, 0.0, normal, light_views=v, samples=samples, per=6, poly=tri,
+                two_sided=True)
     if len(tri_idx) > s.max_shadowed_emissive:
-        warnings.append(f"{len(tri_idx) - s.max_shadowed_emissive} of {len(tri_idx)} emissive triangles light "
-                        "the scene without shadows (only the brightest are shadowed)")
-
-    lights = np.array(records, LIGHT_DTYPE) if records else np.zeros(0, LIGHT_DTYPE)
-    vertices = np.concatenate(polys) if polys else np.zeros((0, 3))
-    vertices = np.concatenate([vertices, np.ones((len(vertices), 1))], axis=1).astype(np.float32)
-    return LightBuffers(lights, views, vertices, warnings, view_lights)
+        out.warnings.append(f"{len(tri_idx) - s.max_shadowed_emissive} of {len(tri_idx)} emissive triangles light "
+                            "the scene without shadows (only the brightest are shadowed)")
 
 
 def pack_views(views: list[ShadowView], tiles: list[tuple], atlas_size: tuple[int, int], pcf_radius: int,

@@ -84,18 +84,9 @@ def voxelize(ctx, programs, scene: Scene, geometry, textures: list, grid: Grid, 
     """
     import moderngl
 
-    if mode not in MODES:
-        raise ValueError(f"unknown voxelisation mode {mode!r} (choose from {', '.join(MODES)})")
+    _check_grid(ctx, grid, mode, supersample)
     supersample = int(supersample)
-    if supersample < 1:
-        raise ValueError("supersample must be ≥ 1")
     nx, ny, nz = grid.size
-    max_3d = int(ctx.info.get("GL_MAX_3D_TEXTURE_SIZE", 2048))
-    if 4 * nx > max_3d or ny > max_3d or nz > max_3d:
-        raise ValueError(f"grid {grid.size} too large: accumulators need 4·nx, ny, nz ≤ {max_3d}")
-    if mode == "raster" and max(grid.size) * supersample > 16384:
-        raise ValueError(f"grid {grid.size} × supersample {supersample} exceeds 16384 pixels")
-
     used = sorted({m for m, _, _ in geometry.ranges})
     albedo_max, emission_max = material_maxima(scene, used)
     accs = [ctx.texture3d((4 * nx, ny, nz), 1, dtype="u4") for _ in range(4)]
@@ -121,10 +112,7 @@ def voxelize(ctx, programs, scene: Scene, geometry, textures: list, grid: Grid, 
             overflow = np.frombuffer(flags.read(), np.uint32)[0] != 0
             if not overflow or scale_bits <= 0:
                 break
-            # A voxel's area sum wrapped: retry with room for the whole scene's area in one voxel, then halve.
-            total_cells = float(scene_area(scene)) / grid.cell ** 2
-            safe = int(np.floor(np.log2(2.0 ** 31 / max(total_cells, 1e-30))))
-            scale_bits = max(0, min(scale_bits - 1, safe) if reruns == 0 else scale_bits - 2)
+            scale_bits = _smaller_scale(scene, grid, scale_bits, reruns)
             reruns += 1
         volumes = _resolve(ctx, programs, accs, grid, scale_bits, albedo_max, emission_max)
     finally:
@@ -133,6 +121,28 @@ def voxelize(ctx, programs, scene: Scene, geometry, textures: list, grid: Grid, 
         if patches is not None:
             patches[0].release()
     return VoxelVolumes(grid, *volumes, mode=mode, supersample=supersample, scale_bits=scale_bits, reruns=reruns)
+
+
+def _check_grid(ctx, grid: Grid, mode: str, supersample) -> None:
+    """ValueError for a mode, supersampling or grid this context cannot voxelise."""
+    if mode not in MODES:
+        raise ValueError(f"unknown voxelisation mode {mode!r} (choose from {', '.join(MODES)})")
+    if int(supersample) < 1:
+        raise ValueError("supersample must be ≥ 1")
+    nx, ny, nz = grid.size
+    max_3d = int(ctx.info.get("GL_MAX_3D_TEXTURE_SIZE", 2048))
+    if 4 * nx > max_3d or ny > max_3d or nz > max_3d:
+        raise ValueError(f"grid {grid.size} too large: accumulators need 4·nx, ny, nz ≤ {max_3d}")
+    if mode == "raster" and max(grid.size) * int(supersample) > 16384:
+        raise ValueError(f"grid {grid.size} × supersample {int(supersample)} exceeds 16384 pixels")
+
+
+def _smaller_scale(scene: Scene, grid: Grid, scale_bits: int, reruns: int) -> int:
+    """A voxel's area sum wrapped: the fixed-point fraction bits to retry with — room for the whole scene's area in
+    one voxel on the first retry, then two bits fewer each time."""
+    total_cells = float(scene_area(scene)) / grid.cell ** 2
+    safe = int(np.floor(np.log2(2.0 ** 31 / max(total_cells, 1e-30))))
+    return max(0, min(scale_bits - 1, safe) if reruns == 0 else scale_bits - 2)
 
 
 def scene_area(scene: Scene) -> float:
