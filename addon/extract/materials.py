@@ -1,4 +1,5 @@
-"""Reduce Blender node materials to what the pipeline understands (gpu_kernels.scene.Material).
+"""Materials: Blender node materials reduced to what the pipeline understands (gpu_kernels.scene.Material), and
+the image textures they use (gpu_kernels.scene.Texture).
 
 Understood: Principled BSDF and Diffuse BSDF base colour (constant, or an Image Texture through UV), emission
 colour × strength, roughness, metallic; a lone Emission shader. Anything else falls back to the material's
@@ -9,6 +10,31 @@ from __future__ import annotations
 import numpy as np
 
 from ...gpu_kernels.scene import Material, Texture
+
+
+class MaterialTable:
+    """The Scene's materials in first-use order (the default first) and their textures; each Blender material is
+    read once, keyed by its original name, and the warning reading it gave is appended to `warnings`."""
+
+    def __init__(self, warnings: list):
+        self.warnings = warnings
+        self.materials: list[Material] = [Material("Default", (0.8, 0.8, 0.8))]  # 0: triangles without a material
+        self.textures: list[Texture] = []
+        self.material_ids: dict = {}  # original material name -> index in `materials`
+        self.image_ids: dict = {}  # image name -> index in `textures`
+
+    def index(self, material) -> int:
+        """Index in `materials` of a bpy material (0 for None), reading it the first time it is seen."""
+        if material is None:
+            return 0
+        key = material.original.name if hasattr(material, "original") else material.name
+        if key not in self.material_ids:
+            mat, warn = read_material(material, self.textures, self.image_ids)
+            if warn:
+                self.warnings.append(warn)
+            self.material_ids[key] = len(self.materials)
+            self.materials.append(mat)
+        return self.material_ids[key]
 
 
 def _output_surface_node(tree):
@@ -102,37 +128,3 @@ def read_material(material, textures: list, image_ids: dict) -> tuple[Material, 
         emission = np.array(node.inputs["Color"].default_value[:3]) * strength
         return Material(material.name, (0.0, 0.0, 0.0), emission=tuple(emission)), None
     return fallback, f"material '{material.name}' uses {node.bl_idname}; showing its viewport colour"
-
-
-def world_color(world) -> tuple[tuple, str | None]:
-    """Constant world radiance (colour × strength) and a warning if the world is more than a constant."""
-    tree = world.node_tree if getattr(world, "use_nodes", False) else None
-    if tree is None:
-        return tuple(world.color[:3]), None
-    outs = [n for n in tree.nodes if n.bl_idname == "ShaderNodeOutputWorld" and n.is_active_output] or \
-        [n for n in tree.nodes if n.bl_idname == "ShaderNodeOutputWorld"]
-    if not outs or not outs[0].inputs["Surface"].is_linked:
-        return (0.0, 0.0, 0.0), None
-    node = outs[0].inputs["Surface"].links[0].from_node
-    if node.bl_idname != "ShaderNodeBackground":
-        return tuple(world.color[:3]), f"world uses {node.bl_idname}; using its viewport colour"
-    color = node.inputs["Color"]
-    strength = float(node.inputs["Strength"].default_value)
-    if color.is_linked:
-        return tuple(world.color[:3]), "world colour is driven by nodes (e.g. a sky texture); using its viewport colour"
-    return tuple(np.array(color.default_value[:3]) * strength), None
-
-
-def light_node_scale(tree) -> tuple[np.ndarray, str | None]:
-    """RGB factor a light's node tree applies (Emission colour × strength, as Cycles multiplies it in)."""
-    outs = [n for n in tree.nodes if n.bl_idname == "ShaderNodeOutputLight" and n.is_active_output] or \
-        [n for n in tree.nodes if n.bl_idname == "ShaderNodeOutputLight"]
-    if not outs or not outs[0].inputs["Surface"].is_linked:
-        return np.ones(3), None
-    node = outs[0].inputs["Surface"].links[0].from_node
-    if node.bl_idname != "ShaderNodeEmission":
-        return np.ones(3), f"node tree uses {node.bl_idname}; only the light's colour and power are used"
-    color, strength = node.inputs["Color"], node.inputs["Strength"]
-    if color.is_linked or strength.is_linked:
-        return np.ones(3), "emission driven by nodes; only the light's colour and power are used"
-    return np.array(color.default_value[:3], np.float64) * float(strength.default_value), None
