@@ -1,0 +1,2 @@
+"""GL plumbing: the worker thread and its context, shader preprocessing and programs, the pass cache, and the
+binding helpers every stage uses."""

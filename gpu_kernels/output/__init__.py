@@ -1,0 +1,1 @@
+"""Results on disk and their errors: multi-layer EXR I/O and the error metrics against Cycles."""
