@@ -1,7 +1,7 @@
 """The GPU side's only input: a scene as plain dataclasses and numpy arrays.
 
-Everything here is in Blender's world space (metres, Z up) and Blender's units (design.md §3).
-`addon/extract.py` builds it from a depsgraph; tests and examples may build it by hand. No bpy.
+Everything here is in Blender's world space (metres, Z up) and Blender's units (docs/conventions.md).
+`addon/extract/` builds it from a depsgraph; tests and examples may build it by hand. No bpy.
 """
 from __future__ import annotations
 
@@ -37,7 +37,7 @@ class Material:
 
 @dataclass
 class Light:
-    """A Blender light in Cycles' meaning (design.md §3); `color` already includes energy-independent tint."""
+    """A Blender light in Cycles' meaning (docs/conventions.md); `color` already includes energy-independent tint."""
     name: str
     type: str  # one of LIGHT_TYPES
     color: tuple  # linear RGB tint (temperature applied), not including power

@@ -4,7 +4,7 @@ The view plane follows Blender's `BKE_camera_params_compute_viewplane` (source/b
 which Cycles mirrors (intern/cycles/blender/camera.cpp): the sensor dimension used is picked by the sensor fit,
 lens shift is in units of the fitted dimension, and pixel aspect scales the vertical extent. Pixel (i, j) covers
 [i, i+1] × [j, j+1] of the view plane, sampled at its centre — the same as OpenGL rasterisation, and the same as
-Cycles with a ~0.01 px pixel filter (design.md §3).
+Cycles with a ~0.01 px pixel filter (the reference settings in docs/conventions.md).
 """
 from __future__ import annotations
 

@@ -1,6 +1,6 @@
-"""A regular voxel lattice in world space: cubic cells, origin snapped to whole cells (seed 004 §4.1).
+"""A regular voxel lattice in world space: cubic cells, origin snapped to whole cells (Freed 2018, §4.1).
 
-Seed 004 §4.1: "to prevent some issues with temporal artifacts, the voxel textures are snapped to a discrete
+Freed 2018, §4.1: "to prevent some issues with temporal artifacts, the voxel textures are snapped to a discrete
 grid corresponding to the size of each voxel cell in world space". Here that means `origin / cell` is always an
 integer, so moving the scene bounds (or, for camera-following cascades, the camera) by less than a cell leaves
 every voxel boundary where it was. Grid coordinates: `g = (p − origin) / cell`; voxel (i, j, k) spans

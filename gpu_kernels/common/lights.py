@@ -1,14 +1,14 @@
 """Lights → GPU records, and the shadow views every light needs (pure numpy; no GL here).
 
-Units follow Cycles (design.md §3; intern/cycles/scene/light.cpp):
+Units follow Cycles (docs/conventions.md; intern/cycles/scene/light.cpp):
 - sun: `power` is irradiance at normal incidence (W/m²);
 - point/spot: radiant intensity P/(4π) W/sr; a spot is a point light masked by its cone, not concentrated into it;
 - area: one-sided Lambertian emitter of radiance P/(π·A) over its area A;
 - emissive triangles: radiance = material emission (colour × strength), emitted from both sides as in Cycles.
-Area lights and emissive triangles are "polygon lights", integrated exactly (Lambert's formula) in the shader,
+Area lights and emissive triangles are "polygon lights", integrated exactly (Lambert's polygon formula) in the shader,
 shadowed by a few sample points on the light, each with a six-view shadow cube (the documented approximation).
 
-Every numpy dtype here mirrors a GLSL struct in shaders/lights_common.glsl field for field (std430).
+Every numpy dtype here mirrors a GLSL struct in shaders/common/lights.glsl field for field (std430).
 """
 from __future__ import annotations
 

@@ -1,9 +1,9 @@
 """The one moderngl context, owned by one dedicated worker thread.
 
 Why a thread: a moderngl context created on Blender's main thread silently breaks Blender's own drawing
-(design.md §4), and GL contexts are bound to the thread that made them current. So every GPU call in this
-package runs as a job on `GpuWorker`'s thread; callers get a `concurrent.futures.Future` and results come back
-as numpy arrays.
+(docs/conventions.md, platform facts), and GL contexts are bound to the thread that made them current. So every
+GPU call in this package runs as a job on `GpuWorker`'s thread; callers get a `concurrent.futures.Future` and
+results come back as numpy arrays.
 """
 from __future__ import annotations
 

@@ -1,4 +1,5 @@
-"""Light Propagation Volumes (seeds 000, 001, 002): RSMs → VPL injection → propagation with fuzzy occlusion →
+"""Light Propagation Volumes (Kaplanyan and Dachsbacher 2010; Kaplanyan 2009; Elvek 2012; Olovsson and Doggett
+2013): RSMs → VPL injection → propagation with fuzzy occlusion →
 absorbed light → irradiance. Every scale is derived, none tuned (see the shaders' comments):
 
 - RSM texel → VPL flux Φ = albedo × irradiance × texel area (lpv/inject.glsl), so injection is independent of
@@ -7,10 +8,10 @@ absorbed light → irradiance. Every scale is derived, none tuned (see the shade
 - propagation conserves flux exactly in empty space (far face 0.4006696846 sr + 4 side faces 0.4234313544 sr
   = 2π/3 per neighbour); negative lobes propagate as they are unless `clamp_negative` (which adds energy);
 - lookup (default "flux"): a surface's irradiance is the flux fuzzy occlusion stopped at it, per area — summed
-  over all surfaces this is exactly the injected flux that did not leave the grid (lpv_occlusion.py); the
+  over all surfaces this is exactly the injected flux that did not leave the grid (lpv/occlusion.py); the
   classic lookup, SH intensity convolved with the cosine / cell², is `lookup="intensity"`;
 - bounces: absorbed light × albedo is injected again;
-- transport (default "gather", lpv_gather.py): every surface voxel gathers the VPLs' light directly, bounce by
+- transport (default "gather", lpv/gather.py): every surface voxel gathers the VPLs' light directly, bounce by
   bounce, with fuzzy visibility — the face scheme turns light sideways within a few cells; "propagate" is the
   classic LPV above. World light propagates either way.
 

@@ -1,5 +1,5 @@
-"""lpv_lighting: Diffuse Indirect per G-buffer pixel from the cascades — the surface voxels' absorbed irradiance
-(the flux lookup) or the SH intensity convolved with the cosine (Kaplanyan's lookup)."""
+"""The lpv_lighting pass: Diffuse Indirect per G-buffer pixel from the cascades — the surface voxels' absorbed
+irradiance (the flux lookup) or the SH intensity convolved with the cosine (Kaplanyan's lookup)."""
 from __future__ import annotations
 
 from ..gl.bind import dispatch, set_uniform

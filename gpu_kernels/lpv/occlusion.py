@@ -1,4 +1,4 @@
-"""LPV fuzzy occlusion and the light it stops (seed 000 §3.4): the geometry volume, built from a voxelisation of
+"""LPV fuzzy occlusion and the light it stops (Elvek 2012, §3.4): the geometry volume, built from a voxelisation of
 the whole scene, blocks light at cell faces; the flux it blocks is the light the surfaces there absorb, which
 gives their irradiance (lpv/absorb.glsl) and, times albedo, the next bounce's VPLs (lpv/bounce.glsl).
 """
@@ -15,7 +15,7 @@ from .state import FIXED_RANGE, LpvGridState, resolve
 
 @dataclass
 class GeometryVolume:
-    """Fuzzy occlusion of one cascade (seed 000 §3.4) and the surface voxels that absorb what it stops."""
+    """Fuzzy occlusion of one cascade (Elvek 2012, §3.4) and the surface voxels that absorb what it stops."""
     blocking: object  # RGBA32F 3D texture, LPV size + 1: channel a = blocked fraction of cell c's lower face normal to a
     fine: Grid  # surface voxels: half the LPV cell, offset by half an LPV cell
     area: object  # fine voxel textures from voxelize(): projected areas per axis + total area
@@ -35,7 +35,7 @@ class GeometryVolume:
 def face_blocking(area: np.ndarray, grid: Grid) -> np.ndarray:
     """Blocked fraction of every LPV face from surface voxels of half the cell size (fine grid, origin − cell/2).
 
-    The face between cells c − e_a and c gets the blocking potential of seed 000 §3.4, B = Σ A_s·|n_s·a| / s²
+    The face between cells c − e_a and c gets the blocking potential of Elvek 2012, §3.4, B = Σ A_s·|n_s·a| / s²
     (clamped to 1), summed over the surfels inside the cell-sized box centred on that face — exactly the eight
     fine voxels [2c_a, 2c_a+2) along a and [2c_u+1, 2c_u+3) along the other axes. (A box centred on the face,
     rather than the four corner cells of the classic GV, which average over 2s × 2s and so let a 45° wall block
@@ -107,7 +107,7 @@ def crossing_layers(area: np.ndarray, normal: np.ndarray, grid: Grid) -> tuple[n
 def geometry_volumes(ctx, programs, scene: Scene, geometry, textures, grids: list) -> list:
     """Fuzzy-occlusion volumes, one per cascade, from a voxelisation of the whole scene (view-independent).
 
-    The blocking potential of seed 000 §3.4 is evaluated in closed form at the axis directions — B_a, the fraction
+    The blocking potential of Elvek 2012, §3.4 is evaluated in closed form at the axis directions — B_a, the fraction
     of a face normal to a that surfaces cover — instead of through a 2-band SH projection, because 2-band SH cannot
     hold a two-sided blocker (the band-1 terms of |n·ω| vanish, which would leave a full wall blocking at most half
     the light).

@@ -1,15 +1,15 @@
-"""Octree Light Propagation Volumes (seed 002, Olovsson & Doggett 2013), an option of the LPV (`octree_levels`).
+"""Octree Light Propagation Volumes (Olovsson and Doggett 2013), an option of the LPV (`octree_levels`).
 
 §3.1 A full octree: every level O_i (i = 0..l-1) is a uniform grid of its own (three RGBA32F 3D textures), O_0 the
     LPV grid, O_i = n/2^i cells of 2^i·cell, same origin. The index volume hierarchy I_i says which level to sample;
     S(x) = O_{I(x)}(x >> I(x)) with I(x) = min_i I_i(x >> i) (Eq. 1). Index rule (`index_hierarchy`): a level-i node
     is usable where it and its 26 neighbours (the cells its propagation reads, and the trilinear lookup's reach) hold
     no surface — coarse levels propagate through coarse, blurred occlusion and must not be read next to geometry.
-    So I_i(p) = i−1 where that level-i neighbourhood holds a surface, else l−1 (the seed's initial value; I_0 ≡ l−1):
+    So I_i(p) = i−1 where that level-i neighbourhood holds a surface, else l−1 (the paper's initial value; I_0 ≡ l−1):
     I(x) is the coarsest level whose neighbourhood of x is empty, 0 at and next to geometry.
 §3.2 Injection into O_0 as in the uniform LPV; downsampling into O_1.. by summing the eight children
     (lpv/octree_downsample.glsl: our state is flux per cell, for which Eq. 2's average is a sum — derived there).
-§3.3 Propagation on every level with `octree_iterations` steps (k = 4 in the seed), each level blocked by its own
+§3.3 Propagation on every level with `octree_iterations` steps (k = 4 in the paper), each level blocked by its own
     geometry volume, downsampled from the O_0 voxelisation (`level_blocking`).
 §3.4 Merge M(x) = S(x) into one O_0 volume of accumulated intensity (lpv/octree_merge.glsl: A_i/4^i, derived
     there), then the unchanged lighting step with Kaplanyan's intensity lookup (the flux lookup needs one grid's
@@ -49,7 +49,7 @@ def level_blocking(area0: np.ndarray, grids: list) -> list[np.ndarray]:
     """Face blocking of every level (GV downsampling): the projected areas of the O_0 surface voxels (half an O_0
     cell, origin − cell/2) summed into level-i surface voxels (half a level-i cell, origin − cell_i/2) — an exact
     regrouping, since level-i voxel j starts at O_0 voxel 2^i·j − (2^i − 1) — then the same box rule as O_0
-    (lpv_occlusion.face_blocking). Level 0 reproduces the uniform LPV's blocking exactly."""
+    (lpv/occlusion.face_blocking). Level 0 reproduces the uniform LPV's blocking exactly."""
     out = []
     for i, g in enumerate(grids):
         f = 2 ** i
@@ -244,11 +244,12 @@ def level_fluxes(tree: OctreeState, which: str = "injected") -> list[float]:
 
 
 def octree_errors(tree: OctreeState) -> tuple[float, float]:
-    """Seed 002 §4.1: e_abs, e_rel = mean over the elements of O_1..O_{l-1} of ‖O_i − Ô_i‖∞ (and / ‖O_i‖∞), Ô_i
-    the downsampling of O_{i-1}. Compared: the accumulated volumes in merge units (A_i/4^i, which the seed's
-    "uniform range" means), Ô_i = the mean of the eight children (empty children outside an odd level count as 0).
-    ‖·‖∞ over the 12 coefficients (RGB × 4) as absolute values. e_rel skips (and does not count) elements with ‖O_i‖∞ below 1e-4 of the
-    level's largest (light not yet arrived: float32 crumbs there give ratios of 10⁴ and more, meaningless)."""
+    """Olovsson and Doggett 2013, §4.1: e_abs, e_rel = mean over the elements of O_1..O_{l-1} of ‖O_i − Ô_i‖∞
+    (and / ‖O_i‖∞), Ô_i the downsampling of O_{i-1}. Compared: the accumulated volumes in merge units (A_i/4^i,
+    which the paper's "uniform range" means), Ô_i = the mean of the eight children (empty children outside an odd
+    level count as 0). ‖·‖∞ over the 12 coefficients (RGB × 4) as absolute values. e_rel skips (and does not count)
+    elements with ‖O_i‖∞ below 1e-4 of the level's largest (light not yet arrived: float32 crumbs there give
+    ratios of 10⁴ and more, meaningless)."""
     vols = [read_volumes(s.accum, s.grid) / 4.0 ** i for i, s in enumerate(tree.levels)]
     e_abs, e_rel, count, lit_count = 0.0, 0.0, 0, 0
     for i in range(1, len(vols)):

@@ -43,8 +43,8 @@ def run(frame) -> MethodOutput:
 
 
 def _octree(frame, states, gvs, grids, k_gv, k_inject, k_prop):
-    """The octree LPV's passes (Olovsson and Doggett 2013, "Octree Light Propagation Volumes": index volume, downsample, per-level propagation, merge);
-    returns the merged state as the one cascade the lookup reads, and the lookup's settings."""
+    """The octree LPV's passes (Olovsson and Doggett 2013: index volume, downsample, per-level propagation,
+    merge); returns the merged state as the one cascade the lookup reads, and the lookup's settings."""
     ctx, programs, cache, s = frame.ctx, frame.programs, frame.cache, frame.settings.lpv
     geo = cache.run("lpv_octree_geometry", (k_gv, s.octree_levels),
                     lambda: octree.build_geometry(ctx, gvs[0], grids[0], s.octree_levels))

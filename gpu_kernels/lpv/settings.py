@@ -9,25 +9,25 @@ class LpvSettings:
     resolution: int = 32  # cells along the longest axis of the (finest) grid
     cascades: int = 1  # nested grids, each twice the extent of the last
     rsm_resolution: int = 128  # texels per side of each RSM view (sun: twice that)
-    rsm_downsample: int = 1  # propagate: inject one VPL per k×k RSM texels, intensity-aware (seed 001); 1, 2, 4
+    rsm_downsample: int = 1  # propagate: inject one VPL per k×k RSM texels, intensity-aware (Kaplanyan 2009); 1, 2, 4
     max_iterations: int = 64
     epsilon: float = 1e-3  # stop when one step moved less than this fraction of the injected flux
     occlusion: bool = True  # fuzzy occlusion from the geometry volume
     clamp_negative: bool = False
-    damping: bool = False  # seed 000's directional-derivative damping at lookup
+    damping: bool = False  # Elvek 2012's directional-derivative damping at lookup
     blend_cells: float = 2.0  # cascade border blend width (cells)
     bounces: int = 8  # indirect bounces (1 = light reflected once; Cycles' default 8); > 1 need occlusion
     # Gathered transport: gather this many bounces, extrapolate the rest to `bounces` as a geometric series of the
     # last pass (lpv/tail.glsl); 0 = gather every bounce. The propagating transport propagates every bounce.
     gathered_bounces: int = 4
     lookup: str = "flux"  # "flux": absorbed face flux per area (conserves energy); "intensity": Kaplanyan's I/cell²
-    # Octree LPV (seed 002, lpv_octree.py): 0 = uniform grid; L ≥ 1 = full octree O_0..O_{L-1} (O_0 = this grid,
-    # O_i = n/2^i), index volume, per-level propagation, merge (L = 1: the octree path with one level, which equals
-    # the uniform grid with `octree_iterations` steps, one bounce, intensity lookup).
+    # Octree LPV (Olovsson and Doggett 2013, lpv/octree.py): 0 = uniform grid; L ≥ 1 = full octree O_0..O_{L-1}
+    # (O_0 = this grid, O_i = n/2^i), index volume, per-level propagation, merge (L = 1: the octree path with one
+    # level, which equals the uniform grid with `octree_iterations` steps, one bounce, intensity lookup).
     octree_levels: int = 0
-    octree_iterations: int = 4  # propagation steps on every octree level (seed 002 §4: k = 4)
+    octree_iterations: int = 4  # propagation steps on every octree level (Olovsson and Doggett 2013, §4: k = 4)
     # Transport: "gather" sends light straight from VPLs to every surface voxel with fuzzy visibility, bounce by
-    # bounce (lpv_gather.py: the face scheme turns light sideways within a few cells); "propagate" is the classic
+    # bounce (lpv/gather.py: the face scheme turns light sideways within a few cells); "propagate" is the classic
     # LPV. World light propagates either way. The gather writes surface voxels' irradiance, which only the flux
     # lookup with occlusion reads: the intensity lookup, occlusion=False and the octree always propagate (see
     # `gathers`). `gather_vpls` bounds the VPLs per bounce: RSM texels and surface voxels are clustered to fit.

@@ -80,7 +80,7 @@ class LpvGridState:
         self.face_flux = ctx.buffer(reserve=n * 6 * 16)  # vec4 per cell and direction of travel
         self.front = self.back = None  # absorbed-light irradiance per fine voxel, last pass (set by `absorb`)
         self.front_total = self.back_total = None  # summed over bounces
-        self.vpls = None  # the RSM's VPLs for the gathered transport (lpv_gather.vpl_list)
+        self.vpls = None  # the RSM's VPLs for the gathered transport (lpv/gather.vpl_list)
 
     def release(self):
         for obj in (self.accum_ints, self.injected, self.accum, self.ping, self.pong, self.injected_next,

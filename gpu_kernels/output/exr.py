@@ -1,7 +1,7 @@
 """Multi-part EXR in Blender 5's layout (one part per pass, channels `ViewLayer.<Pass>.<C>`), and PNG previews.
 
 Reading uses `read_image(subimage, miplevel, chbegin, chend, FLOAT)`: the 3-argument form silently returns the
-first part (design.md §3). Writing goes to a temporary file renamed into place, so a failed write never leaves a
+first part (docs/conventions.md). Writing goes to a temporary file renamed into place, so a failed write never leaves a
 half-written file.
 """
 from __future__ import annotations

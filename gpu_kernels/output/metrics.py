@@ -1,4 +1,4 @@
-"""Error metrics against a reference (design.md §3), over pixels that hit geometry."""
+"""Error metrics against a reference (defined in docs/conventions.md), over pixels that hit geometry."""
 from __future__ import annotations
 
 import numpy as np

@@ -1,20 +1,21 @@
-"""Voxel Cone Tracing (seed 004; Crassin et al. 2011): voxelize → inject direct light → mipmap → bounce → trace.
+"""Voxel Cone Tracing (Crassin et al. 2011; Freed 2018): voxelize → inject direct light → mipmap → bounce → trace.
 
-Passes (pipeline.py wires them into the pass cache):
-  vct_voxelize  the shared GPU voxelizer (voxelize.py) on a grid padded so every mip level nests exactly;
+Passes (vct/passes.py runs them through the pass cache):
+  vct_voxelize  the shared GPU voxelizer (voxel/voxelize.py) on a grid padded so every mip level nests exactly;
   vct_inject    surface points rasterised along their dominant axis and lit by every light exactly as the Diffuse
                 Direct pass lights pixels (direct/eval.glsl), averaged into six faces per voxel: the radiance
-                leaving through each face, its coverage and where its surfaces lie (vct_inject*.glsl);
+                leaving through each face, its coverage and where its surfaces lie (vct/inject*.glsl);
   vct_mipmap    the filtered radiance volumes: isotropic (mean of children) or anisotropic (six directions,
                 composited front to back, plus where each texel's surfaces lie along each axis, so a cone skips
-                surfaces behind where it started) (vct/mipmap.glsl, seed 004 §4.4);
+                surfaces behind where it started) (vct/mipmap.glsl, Freed 2018, §4.4);
   vct_bounce    bounces − 1 gathers at the voxel faces, each followed by a re-mip (vct/bounce.glsl);
   vct_trace     diffuse cones per G-buffer pixel (or per s × s block, indirect_scale) → Diffuse Indirect and voxel
-                AO (vct/trace.glsl, seed 004 §4.5.2); with anisotropic volumes each cone is a bundle of sub-rays
+                AO (vct/trace.glsl, Freed 2018, §4.5.2); with anisotropic volumes each cone is a bundle of sub-rays
                 that meet surfaces where they cross them (vct/crossing.glsl);
-  vct_upsample  reduced-resolution results back to every pixel, depth- and normal-aware (vct_upsample.py, seed 003);
-  vct_accumulate  temporal average of jittered cone sets (vct_temporal.py);
-  vct_specular  one glossy cone per pixel → Glossy Indirect (vct_specular.py).
+  vct_upsample  reduced-resolution results back to every pixel, depth- and normal-aware (vct/upsample.py;
+                Kircher and Lawrance 2009's inferred lighting);
+  vct_accumulate  temporal average of jittered cone sets (vct/temporal.py);
+  vct_specular  one glossy cone per pixel → Glossy Indirect (vct/specular.py).
 
 Every scale is derived; the shaders' comments give the derivations (self-occlusion bound, step opacity, anisotropic
 optical depth, the layer test, sub-rays), `cone_table` and `subray_radius` give the cones'. Sky light: the world

@@ -9,9 +9,9 @@ from .volumes import ConeVolumes, Faces, level_sizes
 
 def build_volumes(ctx, programs, faces: Faces, anisotropic: bool, into: ConeVolumes | None = None,
                   layers=None) -> ConeVolumes:
-    """Level 0 from the face radiances, then each level from the one below (vct/mipmap.glsl, seed 004 §4.4), and,
+    """Level 0 from the face radiances, then each level from the one below (vct/mipmap.glsl, Freed 2018, §4.4), and,
     anisotropic, the layer volume (from faces.centroids, or `layers` shared from the volumes of the same geometry).
-    `into`: rebuild existing volumes in place (vct_bounce) instead of allocating new ones."""
+    `into`: rebuild existing volumes in place (the vct_bounce pass) instead of allocating new ones."""
     grid = faces.grid
     sizes = level_sizes(grid, faces.levels)
     count = 6 if anisotropic else 1

@@ -26,7 +26,7 @@ class VctSettings:
     # subrays − 1 around it; each meets surfaces where it crosses them. 1 = the axis only (9 cones: 0.202 / 0.102,
     # 0.099 / 0.036, 0.234 / 0.163). The trace's cost grows about linearly with it.
     subrays: int = 7
-    # Cones per voxel face in the bounce gathers (vct_bounce); 0 = diffuse_cones. Bounced light is smooth, and
+    # Cones per voxel face in the bounce gathers (vct/bounce.py); 0 = diffuse_cones. Bounced light is smooth, and
     # these gathers are most of a multi-bounce frame's time. Default 6, measured against 9 (64³, defaults otherwise,
     # Combined rel-L1 / bounce pass on llvmpipe): Cornell 0.092 vs 0.093 / 3.6 s vs 4.9 s, spot room 0.053 vs
     # 0.058, courtyard 0.180 vs 0.181; 5 cones: 0.095 / 3.2 s, 0.058, 0.169.
@@ -38,24 +38,24 @@ class VctSettings:
     # most of it light missing.
     bounces: int = 8
     # Gather only this many bounces and extrapolate the rest up to `bounces` as a geometric series of the last
-    # increment (vct_cones._extrapolate_tail); 0 = gather every bounce. Each gathered bounce is a full cone pass
+    # increment (vct/bounce.extrapolate_tail); 0 = gather every bounce. Each gathered bounce is a full cone pass
     # over the voxels, the tail a few array operations. Default 4, measured against gathering all 8 (Combined
     # rel-L1, 64³, 9 cones everywhere): Cornell 0.093 vs 0.092, spot room 0.058 vs 0.056, courtyard 0.181 vs 0.180
     # in half the time (Cornell bounce pass 4.8 s vs 11.0 s on llvmpipe); gathering 3 was 0.098 / 0.057 / 0.198.
     gathered_bounces: int = 4
-    # Step / sampled voxel size of the volumetric march (seed 004 listing 4.1 steps by the cone radius): the bounce
+    # Step / sampled voxel size of the volumetric march (Freed 2018, listing 4.1, steps by the cone radius): the bounce
     # gathers, the specular cone, isotropic volumes. The per-pixel sub-rays step one texel (vct/crossing.glsl).
     step_multiplier: float = 0.5
     start_offset: float = 1.5  # voxels along the normal (× ‖n‖₁): the trilinear support of the own texel
-    # One glossy cone per pixel along the reflected view direction → Glossy Indirect (vct_specular.py); pixels
+    # One glossy cone per pixel along the reflected view direction → Glossy Indirect (vct/specular.py); pixels
     # with no glossy closure or rougher than roughness_cutoff run no cone, so scenes without glossy materials pay
     # one texture fetch per pixel.
     specular_cone: bool = True
     roughness_cutoff: float = 0.5  # specular cone skipped above this Principled roughness (Glossy Indirect = 0)
     # Diffuse cones traced at (width/s) × (height/s) and brought back to full resolution by a depth- and
-    # normal-aware upsampling (seed 003, inferred lighting; vct_upsample.py). 1 = every pixel.
+    # normal-aware upsampling (Kircher and Lawrance 2009, inferred lighting; vct/upsample.py). 1 = every pixel.
     indirect_scale: int = 1
-    # Temporal accumulation (vct_temporal.py): each render turns the diffuse cone set about the normal by another
+    # Temporal accumulation (vct/temporal.py): each render turns the diffuse cone set about the normal by another
     # angle and averages into a history, until this many frames are in; any change to the trace's inputs restarts
     # it. 0 or 1 = off.
     temporal_frames: int = 0

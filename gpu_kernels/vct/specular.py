@@ -1,4 +1,4 @@
-"""VCT specular cone (seed 004 §4.5.2: five diffuse cones and one specular cone): one glossy cone per G-buffer pixel
+"""VCT specular cone (Freed 2018, §4.5.2: five diffuse cones and one specular cone): one glossy cone per G-buffer pixel
 along the reflected view direction → the Glossy Indirect pass (vct/specular.glsl).
 
 Aperture: Blender's GGX has α = roughness². Half of the GGX microfacet normals lie within atan(α) of the normal
@@ -7,7 +7,7 @@ the cone's half-angle is 2·atan(α) — the median of the reflected lobe — ca
 Pixels rougher than VctSettings.roughness_cutoff, or with no glossy closure (Glossy Color 0), run no cone and get 0,
 so a scene without glossy materials pays one texture fetch per pixel (measured in benchmarks/vct_bench.py).
 Glossy Color comes from the G-buffer (direct/gbuffer.glsl: Cycles' glossy albedo); Combined adds Glossy Indirect × Glossy
-Color (pipeline.compose_passes). Specular light from the lights themselves (Cycles' Glossy Direct) is not computed.
+Color (compose.compose_passes). Specular light from the lights themselves (Cycles' Glossy Direct) is not computed.
 """
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Temporal accumulation of the VCT diffuse gather, for interactive updates (seed 004 §4.7.2 blends voxel radiance
+"""Temporal accumulation of the VCT diffuse gather, for interactive updates (Freed 2018, §4.7.2, blends voxel radiance
 over frames against flicker; here the pixels' gathers are averaged instead, with a hard reset rather than a blend).
 
 A few cones integrate the hemisphere coarsely: the cone set sees a bright patch or misses it depending on how it is
@@ -7,7 +7,7 @@ and the history keeps the mean of frames 0..k (vct/accumulate.glsl), so the pict
 turns. Frame 0 is unrotated, so the first frame after a reset equals a render without accumulation. The history is
 keyed by every input of the trace (G-buffer: geometry, materials, camera; bounced volumes: lights, world, VCT
 settings; the trace settings): a change restarts it at frame 0, so nothing of the old scene survives (no ghosting).
-pipeline.Pipeline._vct advances one frame per render until VctSettings.temporal_frames are in, then skips.
+vct/passes._per_pixel advances one frame per render until VctSettings.temporal_frames are in, then skips.
 """
 from __future__ import annotations
 

@@ -1,5 +1,5 @@
-"""Reduced-resolution VCT gather brought back to full resolution (seed 003: inferred lighting — lighting at a
-reduced resolution plus discontinuity-aware upsampling).
+"""Reduced-resolution VCT gather brought back to full resolution (inferred lighting, Kircher and Lawrance 2009:
+lighting at a reduced resolution plus discontinuity-aware upsampling).
 
 vct/trace.glsl gathers at every s-th G-buffer pixel (VctSettings.indirect_scale = s: s² fewer cone sets);
 vct/upsample.glsl blends the 2×2 nearest gathers with bilinear × tangent-plane-distance × normal weights, and pixels
@@ -19,7 +19,7 @@ SIGMA_VOXELS = 0.5  # plane-distance scale in voxels (vct/upsample.glsl says why
 
 def upsample(ctx, programs, gbuffer, low: dict, faces, volumes, s, world, rotation_deg=None) -> dict:
     """{'indirect': full-resolution RGBA32F texture (rgb Diffuse Indirect, a AO), 'fixup': pixels traced again at
-    full resolution}. `low` is vct_cones.trace's output at s.indirect_scale."""
+    full resolution}. `low` is vct/trace.trace's output at s.indirect_scale."""
     out, marked = joint_bilateral(ctx, programs, gbuffer, low["indirect"], int(low["scale"]),
                                   SIGMA_VOXELS * volumes.grid.cell)
     if marked:

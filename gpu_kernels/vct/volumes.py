@@ -20,7 +20,7 @@ def mip_levels(resolution: int) -> int:
 
 
 def vct_grid(scene: Scene, settings: VctSettings) -> Grid:
-    """Grid.fit over the scene (1 empty margin voxel, origin snapped to whole cells, seed 004 §4.1), each axis
+    """Grid.fit over the scene (1 empty margin voxel, origin snapped to whole cells, Freed 2018, §4.1), each axis
     padded up to a multiple of 2^(levels − 1) so every parent voxel has exactly 8 children at every level and
     the levels' texel centres nest (no half texels at borders)."""
     lo, hi = scene.bounds()
@@ -43,7 +43,7 @@ class Faces:
     levels: int  # mip levels the volumes built from these faces get
     flux: list = None
     occupied: int = 0
-    centroids: list = None  # vct_inject only: per face, xyz = where its surface points lie, w = ±α_g (vct_inject)
+    centroids: list = None  # vct/inject.py only: per face, xyz = where its surface points lie, w = ±α_g
     missed: int = 0  # faces with coverage that caught no raster sample (lit at the face centre instead)
 
     def release(self):
@@ -55,7 +55,7 @@ class Faces:
 class ConeVolumes:
     """Filtered radiance (premultiplied rgb = α·L, a = α) with `levels` mip levels: 1 isotropic texture or 6
     anisotropic ones (direction of travel +x, −x, +y, −y, +z, −z). `owned` False: a view of another pass's
-    volumes (vct_bounce with bounces = 1), which must not release them."""
+    volumes (the vct_bounce pass with bounces = 1), which must not release them."""
     textures: list
     grid: Grid
     levels: int

@@ -1,18 +1,19 @@
-"""Surface voxelisation on the GPU (seed 004 §4.1): area, albedo·opacity, normal and emission per voxel.
+"""Surface voxelisation on the GPU (Freed 2018, §4.1): area, albedo·opacity, normal and emission per voxel.
 
-Two methods, as compared in seed 004 §5.2.2 / Table 5.2:
-  * ``mode="raster"`` (§4.1.1): dominant-axis projection in a geometry shader, conservative coverage by
-    triangle dilation (or the pixel bounding box for slivers), and an *exact* area per voxel: each fragment clips
-    the original triangle to its pixel and to every voxel slab it crosses in depth (voxel/raster.glsl).
-  * ``mode="tessellation"`` (§4.1.2): the tessellator cuts each triangle into sub-triangles smaller than
-    1/supersample voxel; a geometry shader deposits each at its centroid, with its exact area. Triangles needing a
-    level above GL_MAX_TESS_GEN_LEVEL are split on the CPU first (`split_for_tessellation`).
+Two methods, as compared in Freed 2018, §5.2.2 / Table 5.2:
+  * ``mode="raster"`` (§4.1.1, after Crassin and Green 2012): dominant-axis projection in a geometry shader,
+    conservative coverage by triangle dilation (or the pixel bounding box for slivers), and an *exact* area per
+    voxel: each fragment clips the original triangle to its pixel and to every voxel slab it crosses in depth
+    (voxel/raster.glsl).
+  * ``mode="tessellation"`` (§4.1.2, after Fei et al. 2012): the tessellator cuts each triangle into sub-triangles
+    smaller than 1/supersample voxel; a geometry shader deposits each at its centroid, with its exact area.
+    Triangles needing a level above GL_MAX_TESS_GEN_LEVEL are split on the CPU first (`split_for_tessellation`).
 
 Averages are race-free and deterministic: every quantity is summed with integer ``imageAtomicAdd`` in fixed
 point (1 unit = 2^-scale_bits cell², default 2^-24: a voxel holds up to 256 cell² of surface; the shader flags a
 wrapped sum and `voxelize` re-runs with fewer bits), then a compute pass divides (voxel/resolve.glsl).
 
-Everything here runs on the GL thread that owns `ctx` (gpu_context.GpuWorker), including `VoxelVolumes.read`.
+Everything here runs on the GL thread that owns `ctx` (gl/context.GpuWorker), including `VoxelVolumes.read`.
 """
 from __future__ import annotations
 
@@ -76,9 +77,9 @@ def voxelize(ctx, programs, scene: Scene, geometry, textures: list, grid: Grid, 
              supersample: int = 2, scale_bits: int = DEFAULT_SCALE_BITS) -> VoxelVolumes:
     """Voxelise the scene's surfaces into `grid` (GL thread); returns new textures the caller releases.
 
-    `geometry`: direct.GeometryBuffers of `scene` (raster draws its VBO; tessellation uploads its own patch
+    `geometry`: direct/geometry.GeometryBuffers of `scene` (raster draws its VBO; tessellation uploads its own patch
     buffer with oversized triangles split, so only the material ranges are read). `textures`: the list from
-    direct.upload_textures. `supersample`: raster — pixels per voxel edge, i.e. texture samples per voxel face
+    direct/geometry.upload_textures. `supersample`: raster — pixels per voxel edge, i.e. texture samples per voxel face
     (areas are exact at any value); tessellation — sub-triangles per voxel edge. `scale_bits`: fixed-point
     fraction bits (1 unit = 2^-bits cell²); lowered automatically, and reported, if a voxel's sum would wrap.
     """
@@ -170,7 +171,7 @@ def material_maxima(scene: Scene, used) -> tuple[float, float]:
 
 def split_for_tessellation(positions: np.ndarray, cell: float, supersample: int,
                            max_level: int = MAX_TESS_LEVEL) -> tuple[np.ndarray, np.ndarray]:
-    """Seed 004 §4.1.2 / §5.2.2 footnote 3: split triangles whose longest edge needs a tessellation level above
+    """Freed 2018, §4.1.2 / §5.2.2 footnote 3: split triangles whose longest edge needs a tessellation level above
     `max_level` (level = ceil(edge / cell · supersample)) into m² congruent sub-triangles (m = ceil(level /
     max_level)), so none needs more than the hardware gives. Returns (source triangle index, barycentric corner
     weights (S, 3, 3)) per output triangle, sources in input order; orientation is preserved."""
@@ -212,7 +213,7 @@ def _longest_edge(positions: np.ndarray) -> np.ndarray:
 
 
 def _tessellation_buffers(ctx, scene: Scene, grid: Grid, supersample: int):
-    """The patch VBO (same 11-float layout as direct.upload_geometry; normals unused) with oversized triangles
+    """The patch VBO (same 11-float layout as direct/geometry.upload_geometry; normals unused) with oversized triangles
     split, grouped by material, and draw ranges cut so no draw generates more than TESS_VERTEX_BUDGET vertices.
 
     Why the cut: Mesa 22.3.6 llvmpipe's tessellator (measured here) hands the geometry shader sub-triangles made
@@ -292,7 +293,7 @@ _TESS_STAGES = (("vertex_shader", "VERTEX_SHADER"), ("tess_control_shader", "TES
 def tessellation_program(programs, name: str, defines: dict | None = None):
     """Compile a vertex + tessellation + geometry program (no fragment stage) from one .glsl file.
 
-    ProgramCache/shader_preprocessor only know vertex/fragment/geometry/compute stages, so the stage macro is
+    ProgramCache/gl.preprocessor only know vertex/fragment/geometry/compute stages, so the stage macro is
     injected as an ordinary define (every stage then has the same header length, so one line map serves the
     error report). The program is stored in the ProgramCache's table so `programs.release()` frees it.
     """

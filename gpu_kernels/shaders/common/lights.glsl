@@ -1,5 +1,5 @@
 // Light and shadow-view records shared by the lighting shaders. Each struct mirrors a numpy dtype in
-// gpu_kernels/light_buffers.py field for field (std430); tests/test_light_buffers.py checks the offsets.
+// gpu_kernels/common/lights.py field for field (std430); tests/gpu/test_light_buffers.py checks the offsets.
 #pragma once
 
 #define LIGHT_SUN 0

@@ -1,4 +1,4 @@
-// Material inputs of one draw call (see direct.py: _bind_material) and the diffuse albedo they give.
+// Material inputs of one draw call (see direct/geometry.py: bind_material) and the diffuse albedo they give.
 #pragma once
 
 uniform vec3 u_base_color;

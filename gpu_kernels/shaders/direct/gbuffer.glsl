@@ -1,6 +1,6 @@
 // G-buffer from the scene camera: world position, shading normal, diffuse colour, emission, geometric normal, glossy
 // colour and roughness (the VCT specular cone, vct/specular.glsl).
-// Sampled at pixel centres with no MSAA, like Cycles with a ~0.01 px pixel filter (design.md §3).
+// Sampled at pixel centres with no MSAA, like Cycles with a ~0.01 px pixel filter (docs/conventions.md).
 #if defined(VERTEX_SHADER)
 #include "common/surface_vertex.glsl"
 #endif

@@ -1,6 +1,6 @@
 // Direct diffuse light per pixel from the G-buffer: sun, point, spot (Cycles' smoothstep cone), and polygon lights
 // (area lights and emissive triangles) integrated exactly with Lambert's polygon formula, all shadowed through the
-// shadow atlas. Output is Cycles' Diffuse Direct pass: irradiance/π, albedo divided out (design.md §3).
+// shadow atlas. Output is Cycles' Diffuse Direct pass: irradiance/π, albedo divided out (docs/conventions.md).
 #include "common/lights.glsl"
 #include "common/light_eval.glsl"
 #include "direct/eval.glsl"

@@ -1,4 +1,5 @@
-// Two-band spherical harmonics and the LPV grid (design.md §3 conventions; Kaplanyan & Dachsbacher 2010, seed 001).
+// Two-band spherical harmonics and the LPV grid (Kaplanyan and Dachsbacher 2010; Kaplanyan 2009). SH basis and
+// conventions: docs/conventions.md; the clamped-cosine coefficients are Ramamoorthi and Hanrahan 2001's.
 #pragma once
 
 // Basis: Y00 = 0.282095, Y1-1 = −0.488603·y, Y10 = 0.488603·z, Y11 = −0.488603·x.

@@ -1,5 +1,5 @@
 // Fixed-point accumulation of LPV injections (no float atomics here): 12 ints per cell, RGB × 4 SH coefficients,
-// scaled by u_fixed_scale (lpv.py: FIXED_RANGE / a bound of the flux, so sums stay below 2³¹).
+// scaled by u_fixed_scale (lpv/state.py: FIXED_RANGE / a bound of the flux, so sums stay below 2³¹).
 #pragma once
 #include "lpv/common.glsl"
 
@@ -14,7 +14,7 @@ void add_fixed(int base, vec4 c) {
 }
 
 // A Lambertian emitter of flux Φ (RGB) with normal n: intensity (Φ/π)·max(0, n·ω) on 2-band SH, added to the cell
-// half a cell in front of p (seed 000 §3.3: "offset half a cell size in the direction of its normal").
+// half a cell in front of p (Elvek 2012, §3.3: "offset half a cell size in the direction of its normal").
 void inject_lambertian(LpvGrid g, vec3 p, vec3 n, vec3 flux) {
     if (max(flux.r, max(flux.g, flux.b)) <= 0.0) return;
     ivec3 c = lpv_cell(g, p + n * 0.5 * g.cell);

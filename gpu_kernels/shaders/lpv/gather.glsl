@@ -26,11 +26,11 @@ layout(local_size_x = 64) in;
 layout(std430, binding = 6) readonly buffer VplList { Vpl vpls[]; };
 layout(std430, binding = 7) readonly buffer SurfaceVoxels { ivec4 surfaces[]; };  // fine voxels with surfaces
 uniform int u_surface_count;
-uniform int u_vpl_first;           // this dispatch's VPLs: [first, first + count) (see lpv_gather.gather)
+uniform int u_vpl_first;           // this dispatch's VPLs: [first, first + count) (see lpv/gather.gather)
 uniform int u_vpl_count;
 uniform sampler3D u_voxel_normal;   // fine voxels: mean sign-canonical normal
 uniform sampler3D u_voxel_area;     // fine voxels: rgb projected areas, a = surface area (m²)
-uniform sampler3D u_coverage;       // LPV cells: covered fraction of the x/y/z cross-sections (lpv_occlusion.py)
+uniform sampler3D u_coverage;       // LPV cells: covered fraction of the x/y/z cross-sections (lpv/occlusion.py)
 uniform sampler3D u_layers;         // LPV cells: where those surfaces lie along x/y/z, in cells
 uniform bool u_occlusion;
 uniform vec3 u_fine_origin;
@@ -50,14 +50,14 @@ vec3 step01(vec3 d) {
 }
 const float NEAR_FIELD = 9.0;  // (distance / disc radius)² below which a VPL is split in four
 
-// Visibility between a VPL at `from` and a receiver `dist` away along unit `dir`: the ray walks the LPV cells it
-// passes (Amanatides & Woo's traversal) and, in each, meets the cell's surfaces only if it crosses the plane where
+// Visibility between a VPL at `from` and a receiver `dist` away along unit `dir`: the ray walks the LPV cells it passes
+// (the traversal of Amanatides and Woo 1987) and, in each, meets the cell's surfaces only if it crosses the plane where
 // they lie inside the cell — one oblique plane, or one per axis where a floor meets a wall (u_coverage, u_layers:
-// lpv_occlusion.crossing_layers) — then their covered fraction of the light is stopped, as the geometry volume
-// stops it at a face in propagation. A ray passing a wall without crossing it is not dimmed (a
-// trilinear density would, within a cell of every wall and corner). Crossings within END_CELLS along an axis of
-// either end (along the plane's normal) belong to the VPL's or the receiver's own surface (the planes are the
-// voxels' centres, off the surface by up to a quarter cell) and are not counted.
+// lpv/occlusion.crossing_layers) — then their covered fraction of the light is stopped, as the geometry volume stops it
+// at a face in propagation. A ray passing a wall without crossing it is not dimmed (a trilinear density would, within a
+// cell of every wall and corner). Crossings within END_CELLS along an axis of either end (along the plane's normal)
+// belong to the VPL's or the receiver's own surface (the planes are the voxels' centres, off the surface by up to a
+// quarter cell) and are not counted.
 float transmittance(vec3 from, vec3 dir, float dist) {
     if (!u_occlusion) return 1.0;
     vec3 o = (from - u_grid_origin) / u_grid_cell;  // in cells

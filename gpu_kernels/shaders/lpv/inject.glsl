@@ -1,7 +1,7 @@
-// LPV injection (seed 000 §3.3, seed 001): every RSM texel is a VPL of flux Φ = albedo × (irradiance × texel area);
-// its intensity (Φ/π)·max(0, n·ω) is projected on 2-band SH and added to the cell half a cell in front of it.
-// Accumulation is exact fixed point (integer atomics; no float atomics here), scaled by u_fixed_scale.
-// Because Φ carries the texel's world area, the result does not depend on the RSM resolution.
+// LPV injection (Elvek 2012, §3.3; Kaplanyan 2009): every RSM texel is a VPL of flux Φ = albedo × (irradiance × texel
+// area); its intensity (Φ/π)·max(0, n·ω) is projected on 2-band SH and added to the cell half a cell in front of it.
+// Accumulation is exact fixed point (integer atomics; no float atomics here), scaled by u_fixed_scale. Because Φ
+// carries the texel's world area, the result does not depend on the RSM resolution.
 // MODE_LIST: the same VPLs are written to a list instead (two slots per block; w = 1 marks a VPL), for the gathered
 // first bounce (lpv/gather.glsl).
 #include "common/lights.glsl"
@@ -14,7 +14,7 @@ uniform sampler2D u_rsm_normal;
 uniform sampler2D u_rsm_albedo;
 uniform ivec2 u_rsm_size;
 uniform int u_rsm_resolution;     // texels per RSM view side
-uniform int u_downsample;         // k: each k×k block of texels becomes one VPL (seed 001 N.5.2, intensity-aware)
+uniform int u_downsample;         // k: each k×k block of texels becomes one VPL (Kaplanyan 2009, §N.5.2)
 uniform vec3 u_grid_origin;
 uniform float u_grid_cell;
 uniform ivec3 u_grid_size;
@@ -84,8 +84,8 @@ vec3 vpl_flux(RsmView v, vec3 p, vec3 n, vec3 albedo) {
 }
 
 void main() {
-    // Intensity-aware clustering (seed 001 N.5.2): a k×k block of RSM texels becomes a VPL with the block's total
-    // flux, at the luminance-weighted mean position and normal — flux is kept exactly, and the VPL sits where the
+    // Intensity-aware clustering (Kaplanyan 2009, §N.5.2): a k×k block of RSM texels becomes a VPL with the block's
+    // total flux, at the luminance-weighted mean position and normal — flux is kept exactly, and the VPL sits where the
     // light is. A block can span two surfaces (a sunlit roof and, through its opening, the floor 3 m below): their
     // mean would float in the air between them, so texels off the plane of the block's first lit texel (normal
     // more than ~25° away, or more than half a cell from its plane) form a second VPL. Blocks never straddle views:

@@ -5,11 +5,11 @@
 // The eight geometry-volume cells around the point are blended trilinearly, skipping empty ones, taking each
 // voxel's side that faces the same way as the point's normal.
 //
-// Otherwise, Kaplanyan's intensity lookup (seed 000 §3.3.1): irradiance at a G-buffer point is the accumulated intensity
-// distribution convolved with the clamped cosine about −n (light arriving at the surface travels along −n),
-// E = c · lobe(−n) / cell², where intensity / cell² is the radiance of a cell of cross-section cell² (the LPV stores
-// radiant intensity per cell). Volumes are sampled trilinearly half a cell in front of the surface, matching the
-// half-cell injection offset. Cascades: the finest cascade containing the point wins, blended into the next one
+// Otherwise, Kaplanyan's intensity lookup (as Elvek 2012, §3.3.1, describes it): irradiance at a G-buffer point is the
+// accumulated intensity distribution convolved with the clamped cosine about −n (light arriving at the surface travels
+// along −n), E = c · lobe(−n) / cell², where intensity / cell² is the radiance of a cell of cross-section cell² (the
+// LPV stores radiant intensity per cell). Volumes are sampled trilinearly half a cell in front of the surface, matching
+// the half-cell injection offset. Cascades: the finest cascade containing the point wins, blended into the next one
 // over its outer cells so the border does not show. Output is Cycles' Diffuse Indirect pass: E/π.
 #include "lpv/common.glsl"
 
@@ -26,7 +26,7 @@ uniform float u_grid_cell[MAX_CASCADES];
 uniform ivec3 u_grid_size[MAX_CASCADES];
 uniform int u_cascades;
 uniform float u_blend_cells;     // width of the blend band at a cascade's border, in its cells
-uniform bool u_damping;          // seed 000's directional-derivative damping against leaks
+uniform bool u_damping;          // Elvek 2012's directional-derivative damping against leaks
 uniform ivec2 u_image_size;
 #if defined(MODE_FLUX)
 uniform sampler3D u_front[MAX_CASCADES];   // per fine voxel: rgb irradiance of its surfaces' front side, a = 1 if any
@@ -76,7 +76,7 @@ vec3 sample_cascade(int i, vec3 p, vec3 n) {
     vec3 uvw = (p - u_grid_origin[i]) / (u_grid_cell[i] * vec3(u_grid_size[i]));
     vec4 r = texture(u_accum_r[i], uvw), g = texture(u_accum_g[i], uvw), b = texture(u_accum_b[i], uvw);
     if (u_damping) {
-        // Seed 000 §3.3.1: where the SH coefficients grow against the normal (∇_n c · c < 0), the light comes
+        // Elvek 2012, §3.3.1: where the SH coefficients grow against the normal (∇_n c · c < 0), the light comes
         // from behind the surface (a leak): damp it by how strongly the derivative disagrees.
         vec3 step = n * 0.5 / vec3(u_grid_size[i]);
         vec4 dc = texture(u_accum_r[i], uvw + step) - texture(u_accum_r[i], uvw - step)

@@ -1,4 +1,5 @@
-// Octree LPV downsampling (seed 002 §3.2, Eq. 2): O_i(x) from the eight elements O_{i-1}([2x, 2x+1], ...).
+// Octree LPV downsampling (Olovsson and Doggett 2013, §3.2, Eq. 2): O_i(x) from the eight elements
+// O_{i-1}([2x, 2x+1], ...).
 // Eq. 2 averages, to keep "a uniform range of light intensities" across levels for a state that is a density.
 // Our state is extensive: a cell's SH coefficients are the radiant intensity (W/sr) of all the light in that cell
 // (flux = c0·2√π, lpv/common.glsl), and propagation moves that flux cell to cell. The light in a parent cell is the

@@ -1,14 +1,15 @@
-// Octree LPV merge (seed 002 §3.4): M(x) = S(x), one O_0-sized volume that the unchanged lighting step reads.
+// Octree LPV merge (Olovsson and Doggett 2013, §3.4): M(x) = S(x), one O_0-sized volume that the unchanged
+// lighting step reads.
 // S (Eq. 1): I(x) = min_i I_i(x >> i) over the index hierarchy (§3.1), then sample O_{I(x)}(x >> I(x)).
 //
 // What is merged is each level's ACCUMULATED intensity A_i (injected + every propagation step), which Kaplanyan's
 // lookup turns into irradiance as E = A·lobe/cell_i² (lpv/lighting.glsl): A/cell² is a radiance, the quantity that
-// must be uniform across levels (the seed's "uniform range of light intensities"). A level-i cell is 2^i O_0 cells
+// must be uniform across levels (the paper's "uniform range of light intensities"). A level-i cell is 2^i O_0 cells
 // wide, so an O_0 cell gets A_i / 4^i: then A/cell_0² = A_i/cell_i², the level's own radiance. (Per photon: light
 // crossing a parent cell adds its intensity once to A_i; crossing the same region at O_0 it adds it once in each of
 // the 2^i children on its path, i.e. 2^i/8^i = 1/4^i per child on average. The injected light, counted once in its
-// cell, shares 1/8^i instead: lpv_octree.propagate_levels starts A_i with J_i/2^i.) The flux lookup cannot be used on M:
-// every level holds ALL the injected light, and the flux a surface absorbs is a sum over the whole propagation
+// cell, shares 1/8^i instead: lpv/octree.propagate_levels starts A_i with J_i/2^i.) The flux lookup cannot be used
+// on M: every level holds ALL the injected light, and the flux a surface absorbs is a sum over the whole propagation
 // history of one grid, which a per-cell choice of level does not have.
 #include "lpv/common.glsl"
 

@@ -1,9 +1,9 @@
-// One LPV propagation step, gathering (Kaplanyan & Dachsbacher 2010; seed 000 §3.3.1, seed 001 N.5).
+// One LPV propagation step, gathering (Kaplanyan and Dachsbacher 2010; Elvek 2012, §3.3.1; Kaplanyan 2009, §N.5).
 // Each cell receives light from its six neighbours. From a neighbour, light reaches the five faces of this cell
 // that do not touch it: the far face subtends 0.4006696846 sr from the neighbour's centre and each side face
 // 0.4234313544 sr (far + 4·side = 2π/3, so six neighbours share exactly 4π — flux is conserved). The flux through a
 // face, Φ = I(ω_face)·Δω, is re-emitted from this cell's centre as a clamped cosine lobe toward that face,
-// (Φ/π)·lobe, whose flux is again Φ. Fuzzy occlusion (seed 000 §3.4) scales the light crossing the shared face by
+// (Φ/π)·lobe, whose flux is again Φ. Fuzzy occlusion (Elvek 2012, §3.4) scales the light crossing the shared face by
 // the fraction of that face left open by the geometry volume. The result goes to u_dst and is added to u_accum.
 // It also accumulates, per cell and per direction of travel, the flux incident on the face it shares with that
 // neighbour (before blocking): every face crossing is counted once, and light stopped at a face is counted exactly

@@ -1,4 +1,4 @@
-// VCT multiple bounces (seed 004 traces cones from pixels only; gathering at the voxels too is the same estimator
+// VCT multiple bounces (Freed 2018 traces cones from pixels only; gathering at the voxels too is the same estimator
 // applied to the voxel faces): each occupied voxel face g gathers the irradiance E_g arriving over the hemisphere
 // of its outward normal from the current radiance volumes (vct/common.glsl), and its outgoing radiance becomes
 //   L_g = L_direct,g + albedo · E_g / π

@@ -1,6 +1,7 @@
-// Voxel cone tracing (seed 004 §3.4, §4.5.2; Crassin et al. 2011): the grid, the cone table, one cone step through
+// Voxel cone tracing (Crassin et al. 2011; Freed 2018, §3.4, §4.5.2): the grid, the cone table, one cone step through
 // the filtered radiance volumes, and the cosine-weighted hemisphere gather shared by the per-voxel bounce pass
-// (vct/bounce.glsl) and the per-pixel trace (vct/trace.glsl). vct.py documents every constant.
+// (vct/bounce.glsl) and the per-pixel trace (vct/trace.glsl). gpu_kernels/vct/ (settings.py, cones.py) documents
+// every constant.
 //
 // Volumes hold optical depth τ and τ-weighted radiance (rgb = τ·S, a = τ), see vct/mipmap.glsl.
 // MODE_ANISO: six volumes, one per direction of travel (+x, −x, +y, −y, +z, −z), each holding what a ray
@@ -18,13 +19,13 @@ uniform float u_max_lod;         // coarsest mip level
 uniform int u_cone_count;
 uniform vec4 u_cones[MAX_CONES]; // xyz: unit direction in the normal's frame (z = normal); w: weight ∫region cosθ dω
 uniform float u_cone_tan[MAX_CONES];   // tan(half-angle)
-uniform float u_step;            // step length / sampled voxel size (seed 004 listing 4.1 steps by the radius: 0.5)
+uniform float u_step;            // step length / sampled voxel size (Freed 2018, listing 4.1, steps by the radius: 0.5)
 uniform float u_offset;          // start offset along the geometric normal, in voxels (scaled by ‖n‖₁, see below)
 uniform float u_max_distance;    // metres; 0 = until the cone leaves the grid
 uniform float u_ao_distance;     // metres; 0 = AO is the sky visibility (transmittance of cones leaving the grid)
 uniform vec3 u_world;            // world (background) radiance, seen through what is left of a cone leaving the grid
 
-uniform sampler3D u_centroid[6]; // vct_inject: per face, xyz = its surface centroid, w = ±coverage (0: no surface)
+uniform sampler3D u_centroid[6]; // vct/inject.glsl: per face, xyz = its surface centroid, w = ±coverage (0: no surface)
 #include "vct/arrays.glsl"
 VCT_FETCH6(centroid_face, u_centroid)
 #if defined(MODE_ANISO)
@@ -37,7 +38,7 @@ uniform sampler3D u_volume[1];
 const float VCT_PI = 3.14159265358979;
 
 // Premultiplied radiance and opacity of one step of k texels of the sampled level along unit direction d, from
-// volumes storing (τ·S, τ) (vct/mipmap.glsl): α' = 1 − e^(−k·τ), the step-length correction of the seed's
+// volumes storing (τ·S, τ) (vct/mipmap.glsl): α' = 1 − e^(−k·τ), the usual step-length correction
 // α' = 1 − (1 − α)^k written in optical depth; radiance S = τ·S / τ, the τ-weighted mean of the filtered texels.
 // Anisotropic: τ_i of the volume for the sign of d_i is the optical depth of crossing one texel along axis i. A
 // planar layer with normal along i is crossed once by a ray at any angle, so its optical depth per unit length
@@ -101,7 +102,7 @@ struct ConeResult {
 // tangent plane, so a sample at height h above that plane reads none of p's own texels iff h ≥ 1.5·V·‖n‖₁. Hence
 // the start offset of 1.5 voxels (× ‖n‖₁) along the normal, and the level is capped at
 // floor(log2(h / (1.5·‖n‖₁·cell))): grazing cones sample finer levels (more, shorter steps) rather than the surface
-// they start from. The level otherwise follows the cone diameter (seed 004 listing 4.1: lod = log2(diameter)).
+// they start from. The level otherwise follows the cone diameter (Freed 2018, listing 4.1: lod = log2(diameter)).
 // Known bias (measured): a capped cone reads a footprint narrower than itself, so a bright area at its centre counts
 // for the whole cone — a 3 m lit square seen from 3 m above came out 35% too bright, a 0.6 m one 20% too dark.
 // Four lateral samples per capped step did not help (+56% on the 3 m square): τ blended across a surface's edge
@@ -185,8 +186,8 @@ vec3 cone_origin(vec3 p, vec3 n_geo) {
 #endif
 
 // Irradiance E at p over the hemisphere of n (rgb), and the cosine-weighted AO / sky visibility (a, in [0, 1]):
-// E = Σ_k w_k·(L_k + T_k·L_world if cone k left the grid), with Σ_k w_k = π (vct.cone_table).
-// rot = (cos φ, sin φ): the cone set turned by φ around the normal (vct_temporal.py jitters φ from frame to frame;
+// E = Σ_k w_k·(L_k + T_k·L_world if cone k left the grid), with Σ_k w_k = π (vct/cones.cone_table).
+// rot = (cos φ, sin φ): the cone set turned by φ around the normal (vct/temporal.py jitters φ from frame to frame;
 // the weights are unchanged, since rotating the regions about the normal keeps their cosine integrals).
 vec4 gather_irradiance(vec3 p, vec3 n, vec3 n_geo, vec2 rot) {
     vec3 o = cone_origin(p, n_geo);

@@ -19,9 +19,10 @@
 // lit patch over its neighbours' sub-rays: a 3 × 2.5 m lit patch seen from a plate 3 m above came out 1.23× the
 // exact integral read at the cone's level, 1.01× one level finer).
 // Consequences: a surface behind a sub-ray's start is never crossed, so cones need no level cap (the level follows
-// the diameter, seed 004 listing 4.1); a sub-ray level with a floor never meets it, one tilted down meets it where
+// the diameter, Freed 2018, listing 4.1); a sub-ray level with a floor never meets it, one tilted down meets it where
 // it actually gets there; a sub-ray is absorbed only by surfaces it passes through, so one leaving the grid sees the
-// world with what is left of it. Measured against exact integrals and Cycles: see vct.py (VctSettings.subrays).
+// world with what is left of it. Measured against exact integrals and Cycles: see vct/settings.py
+// (VctSettings.subrays).
 #pragma once
 #if defined(MODE_CROSSING)
 

@@ -10,7 +10,7 @@
 //   c_g = Σ w·p / Σ w, where those surface points lie (the bounce pass gathers from there).
 // A face that has coverage but caught no fragment (a sliver thinner than the raster's pixels) falls back to one
 // evaluation at the face centre with the face normal: L_g = albedo·E(centre + n_g·cell/2, n_g)/π.
-// Emission is not injected: emissive triangles are lights (light_buffers.py), so E already carries their light,
+// Emission is not injected: emissive triangles are lights (common/lights.py), so E already carries their light,
 // and adding it again would count it twice (Cycles' Diffuse Indirect never holds emission).
 // MODE_CLEAR zeroes the accumulator; MODE_RESOLVE writes the faces: rgb = L_g, a = α_g, and centroids: xyz = c_g,
 // w = α_g (or the face centre and w = −α_g for a fallback face; w = 0 where the voxel has no surface).

@@ -1,7 +1,7 @@
-// VCT radiance injection from real surface points (seed 004 §4.3 injects the lit surface points of the shadow map;
+// VCT radiance injection from real surface points (Freed 2018, §4.3, injects the lit surface points of the shadow map;
 // here every surface point is rasterised, lit or not, so shadowed faces get their 0 too).
 //
-// Geometry shader: each triangle is projected along the dominant axis of its normal (seed 004 §4.1.1, Algorithm 1)
+// Geometry shader: each triangle is projected along the dominant axis of its normal (Freed 2018, §4.1.1, Algorithm 1)
 // onto a plane of VCT_SAMPLES pixels per voxel edge; every fragment is a point p on the surface, with the
 // triangle's geometric normal n and its material's diffuse albedo (base colour or texture × (1 − metallic), as the
 // voxelizer defines it).

@@ -1,4 +1,4 @@
-// VCT radiance filtering (seed 004 §4.4: "a compute shader kernel is launched for each level ... averaging the
+// VCT radiance filtering (Freed 2018, §4.4: "a compute shader kernel is launched for each level ... averaging the
 // surrounding 8 values"). Volumes store optical depth and τ-weighted radiance, rgb = τ·S, a = τ:
 //   τ = optical depth of crossing one texel of that level (along the volume's axis when anisotropic),
 //   S = the radiance it sends back toward the ray (W/(m²·sr)).
@@ -24,7 +24,7 @@
 // MODE_DOWN: level l from level l − 1 (sizes are multiples of 2^max_level, so every parent has 8 children).
 //   isotropic: the mean extinction coefficient σ = τ/V of the 8 children, so τ_parent = 2·mean τ (the parent is
 //     twice as long), and likewise τ·S: Σ τ·S·V² (the filtered medium's emission) is conserved exactly, and a
-//     wall that fills one layer of children keeps its optical depth (tests/test_vct.py).
+//     wall that fills one layer of children keeps its optical depth (tests/gpu/test_vct.py).
 //   MODE_ANISO: for direction f, the 4 columns of 2 children along f's axis are composited front to back in the
 //     direction of travel, C = C_front + (1 − α_front)·C_back, α = α_front + (1 − α_front)·α_back (premultiplied
 //     C = α·S), the columns averaged in (C, α) (see below why α and not τ), and stored back as τ = −ln(1 − α),

@@ -1,11 +1,11 @@
-// VCT specular cone (seed 004 §4.5.2: "five [cones] for diffuse light and one for a specular highlight", oriented
+// VCT specular cone (Freed 2018, §4.5.2: "five [cones] for diffuse light and one for a specular highlight", oriented
 // along reflect(−v, n)): one glossy cone per G-buffer pixel → Glossy Indirect, the radiance arriving from around the
-// mirror direction, i.e. the reflected light divided by Glossy Color as in Cycles' pass (design.md §3).
+// mirror direction, i.e. the reflected light divided by Glossy Color as in Cycles' pass (docs/conventions.md).
 //
-// Aperture from Principled roughness r (vct_specular.py documents it): Blender's GGX uses α = r². Sampling the GGX
+// Aperture from Principled roughness r (vct/specular.py documents it): Blender's GGX uses α = r². Sampling the GGX
 // normal distribution gives tan²θ_h = α²·ξ / (1 − ξ), so half of the microfacet normals lie within θ_h = atan(α) of
 // n; a normal tilted by θ_h turns the reflected ray by 2·θ_h. The cone's half-angle is therefore 2·atan(α): it holds
-// the reflected directions of the median half of the lobe (r = 0.5 → 28°, r = 0.2 → 4.6°, r = 0 → a ray). The seed
+// the reflected directions of the median half of the lobe (r = 0.5 → 28°, r = 0.2 → 4.6°, r = 0 → a ray). Freed 2018
 // used 0.1·π·r "determined experimentally" (9° at r = 0.5), narrower for rough and wider for near-mirror surfaces.
 // The half-angle is capped at 45° (r ≈ 0.8); above u_roughness_cutoff the cone is skipped (Glossy Indirect = 0).
 #include "vct/common.glsl"

@@ -1,11 +1,12 @@
-// VCT final gather per G-buffer pixel (seed 004 §4.5.2, Algorithm 3): diffuse cones over the hemisphere of the
+// VCT final gather per G-buffer pixel (Freed 2018, §4.5.2, Algorithm 3): diffuse cones over the hemisphere of the
 // shading normal, started from the geometric tangent plane (vct/common.glsl). Output: rgb = Diffuse Indirect
-// (irradiance / π, albedo divided out as in Cycles' pass, design.md §3), a = voxel ambient occlusion
+// (irradiance / π, albedo divided out as in Cycles' pass, docs/conventions.md), a = voxel ambient occlusion
 // (cosine-weighted transmittance; 1 = unoccluded).
 //
-// Reduced resolution (seed 003, inferred lighting): with u_scale = s the output is ceil(W/s) × ceil(H/s) and output
-// texel i gathers at full-resolution pixel i·s + s/2 (clamped to the image), so every traced sample lies exactly on
-// a G-buffer pixel and vct/upsample.glsl can compare its position and normal with its neighbours'.
+// Reduced resolution (inferred lighting, Kircher and Lawrance 2009): with u_scale = s the output is ceil(W/s) ×
+// ceil(H/s) and output texel i gathers at full-resolution pixel i·s + s/2 (clamped to the image), so every traced
+// sample lies exactly on a G-buffer pixel and vct/upsample.glsl can compare its position and normal with its
+// neighbours'.
 // MODE_FIXUP: full resolution, in place: only pixels vct/upsample.glsl marked (a < 0: no low-resolution sample lies
 // on their surface) are traced; the rest keep their upsampled value.
 #include "vct/common.glsl"

@@ -1,7 +1,7 @@
-// Discontinuity-aware upsampling of the reduced-resolution VCT gather (seed 003, "Inferred Lighting": light at a
-// reduced resolution, with the bilinear filter biased by depth and a surface ID so light does not bleed across
-// object edges). Here the low-resolution texels are the gathers at G-buffer pixels i·s + s/2 (vct/trace.glsl), so
-// each one's exact position and normal are read back from the full-resolution G-buffer: a joint bilateral filter
+// Discontinuity-aware upsampling of the reduced-resolution VCT gather (inferred lighting, Kircher and Lawrance 2009:
+// light at a reduced resolution, with the bilinear filter biased by depth and a surface ID so light does not bleed
+// across object edges). Here the low-resolution texels are the gathers at G-buffer pixels i·s + s/2 (vct/trace.glsl),
+// so each one's exact position and normal are read back from the full-resolution G-buffer: a joint bilateral filter
 // (Kopf et al. 2007) over the 2×2 texels around the pixel, weight = bilinear × plane × normal:
 //   plane   exp(−(d/σ)²), d = the larger of the two point-to-tangent-plane distances, σ = u_sigma (metres, half a
 //           voxel: surfaces closer than that share the voxels their cones start in, so their gathers barely differ;

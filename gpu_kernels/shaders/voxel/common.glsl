@@ -1,11 +1,11 @@
 // Shared by voxel/raster.glsl and voxel/tess.glsl: material inputs and the fixed-point deposit of one
-// surface piece into the voxel accumulators (seed 004 §4.1: "we average the resulting color value using atomic
+// surface piece into the voxel accumulators (Freed 2018, §4.1: "we average the resulting color value using atomic
 // operations"). There are no float atomics in GL 4.5, so every quantity is summed as an integer: uint atomics
 // commute, so the sums, and the resolve that divides them, are bit-identical whatever order fragments arrive in.
 //
 // Accumulators: four r32ui 3D images of (4·nx, ny, nz); channel c of voxel (x, y, z) lives at (4x + c, y, z) so
 // one piece's adds touch neighbouring texels. Fixed point: 1 unit = 2^-scale_bits cell² of area, u_fixed_scale =
-// 2^scale_bits (voxelize.py picks the bits and re-runs with fewer if a voxel's total wraps, see u_flags).
+// 2^scale_bits (voxel/voxelize.py picks the bits and re-runs with fewer if a voxel's total wraps, see u_flags).
 //   acc_area:     A|n.x|, A|n.y|, A|n.z|, A            (unsigned)
 //   acc_albedo:   A·albedo.rgb / u_albedo_max          (unsigned; .w unused)
 //   acc_normal:   A·n.xyz / 2                          (two's complement int in a uint; |Σ A n/2| < 2^31)

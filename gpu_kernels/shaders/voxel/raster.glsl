@@ -1,9 +1,10 @@
-// Rasterisation-based surface voxelisation (seed 004 §4.1.1, after Crassin & Green [10]).
+// Rasterisation-based surface voxelisation (Freed 2018, §4.1.1, after Crassin and Green 2012).
 //
 // Geometry shader: project each triangle along the dominant axis of its normal (Algorithm 1) onto a plane
 // rasterised at `u_supersample` pixels per voxel, and make coverage conservative by drawing, instead of the
 // triangle, whichever is smaller of (a) the triangle with each edge pushed out by half a pixel diagonal
-// (the "dilation in a geometry shader" alternative of §4.1.1, Hasselgren et al.) and (b) its pixel bounding box.
+// (the "dilation in a geometry shader" alternative of Freed's §4.1.1, Hasselgren et al. 2005) and (b) its pixel
+// bounding box.
 // Either contains the centre of every pixel the triangle touches, so thin or tiny triangles still get fragments.
 //
 // Fragment shader: clip the *original* triangle exactly to the fragment's pixel square and then to each

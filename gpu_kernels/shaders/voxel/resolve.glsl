@@ -1,4 +1,4 @@
-// Compute passes around voxelisation (seed 004 §4.1): MODE_CLEAR zeroes the fixed-point accumulators,
+// Compute passes around voxelisation (Freed 2018, §4.1): MODE_CLEAR zeroes the fixed-point accumulators,
 // MODE_RESOLVE turns their integer sums (voxel/common.glsl) into the RGBA32F volumes:
 //   area     rgb = Σ A|n.x|, Σ A|n.y|, Σ A|n.z| (m²), a = Σ A (m²)
 //   albedo   rgb = Σ A·albedo / Σ A, a = opacity = min(1, max projected area / cell²)

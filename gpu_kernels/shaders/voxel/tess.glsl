@@ -1,13 +1,13 @@
-// Tessellation-based surface voxelisation (seed 004 §4.1.2; Fei et al. [17]): no rasterisation.
+// Tessellation-based surface voxelisation (Freed 2018, §4.1.2; Fei et al. 2012): no rasterisation.
 //
 // The control shader picks tessellation levels from the triangle's size in voxels so that every generated
 // sub-triangle is smaller than a voxel (1/u_supersample of one); the evaluation shader places the generated
 // vertices on the triangle; a geometry shader takes each sub-triangle and writes it, as a point at its centroid,
 // into the voxel containing that centroid, with its exact area (the sub-triangles tile the patch, so their
 // areas sum to the triangle's). The rasteriser is switched off (GL_RASTERIZER_DISCARD); nothing is emitted.
-// Triangles that would need more than u_max_level are split on the CPU first (voxelize.py), as §4.1.2 and
+// Triangles that would need more than u_max_level are split on the CPU first (voxel/voxelize.py), as Freed's §4.1.2 and
 // footnote 3 of §5.2.2 suggest.
-// Stage macros TESS_CONTROL_SHADER / TESS_EVALUATION_SHADER are injected by voxelize.py.
+// Stage macros TESS_CONTROL_SHADER / TESS_EVALUATION_SHADER are injected by voxel/voxelize.py.
 #if defined(VERTEX_SHADER)
 layout(location = 0) in vec3 in_position;
 layout(location = 1) in vec2 in_uv;
