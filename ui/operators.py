@@ -25,8 +25,9 @@ def _set_status(context, text):
 
 def _report_done(op, report) -> None:
     total = report.timings.get("total", report.wall_seconds)
+    written = f"; passes written to {report.output}" if report.output else ""
     op.report({"INFO"}, f"Bounce GI: {report.width}x{report.height} {report.method} in {total * 1000:.0f} ms "
-                        f"(waited {report.wall_seconds:.2f} s)")
+                        f"(waited {report.wall_seconds:.2f} s){written}")
     if report.warnings:
         more = f" (+{len(report.warnings) - 1} more in the panel)" if len(report.warnings) > 1 else ""
         op.report({"WARNING"}, f"Bounce GI: {report.warnings[0]}{more}")

@@ -68,6 +68,8 @@ class VIEW3D_PT_bounce_gi_last_render(Panel):
         layout.label(text=f"{last.method.upper()}  {last.width} x {last.height}", icon="IMAGE_DATA")
         if last.quality:
             layout.label(text=last.quality, icon="AUTO")
+        if last.output:
+            layout.label(text=f"Passes: {bpy.path.basename(last.output)}", icon="FILE_IMAGE")
 
         col = layout.column(align=True)
         # Engine order is pipeline order; "total" goes last, then the wall time the user waited.

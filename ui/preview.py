@@ -1,8 +1,9 @@
 """The steps of a preview render as plain functions, and the runtime state of the last one.
 
 The operator (operators.py) only schedules these steps: start_render() extracts the scene and
-submits it to the engine, finish_render() waits for the Future and writes the image. Keeping
-them plain lets tests run a whole preview in background mode, where modal operators never run.
+submits it to the engine, finish_render() waits for the Future, writes the image and, when the
+Output setting names a file, the render passes as a multi-layer EXR. Keeping them plain lets tests
+run a whole preview in background mode, where modal operators never run.
 
 Engine and extraction modules are imported inside the functions, so registering the UI never
 needs moderngl (a missing wheel shows up as one error line when rendering, not as a failed
@@ -10,6 +11,7 @@ register()).
 """
 from __future__ import annotations
 
+import os
 import time
 import traceback
 from dataclasses import dataclass, field
@@ -35,6 +37,7 @@ class RenderReport:
     wall_seconds: float  # submit to image written, as the user waited for it
     skipped: list = field(default_factory=list)  # passes reused from the engine's cache (time 0)
     quality: str = ""  # what the time budget chose, and why ("" when the method was chosen by hand)
+    output: str = ""  # the EXR file the passes were written to ("" when the Output setting is empty)
 
 
 @dataclass
@@ -66,6 +69,7 @@ class PendingRender:
     scene_warnings: list = field(default_factory=list)
     started: float = field(default_factory=time.perf_counter)
     quality: str = ""
+    output: str = ""  # absolute path of the EXR to write the passes to, "" for none
 
     def elapsed(self) -> float:
         return time.perf_counter() - self.started
@@ -112,6 +116,7 @@ def start_render(scene, depsgraph) -> PendingRender:
         raise PreviewError(f"Bounce GI engine unavailable: {one_line(ex)}") from None
 
     settings = scene.bounce_gi
+    output = output_file(settings.output_path)  # a bad path fails here, before anything renders
     method = settings.method_id()
     width, height = preview_resolution(scene, settings.resolution_percentage)
     try:
@@ -134,7 +139,43 @@ def start_render(scene, depsgraph) -> PendingRender:
         raise PreviewError(one_line(ex)) from None
     except Exception as ex:
         raise _unexpected(ex, "render submission") from None
-    return PendingRender(future, method, width, height, list(scene_data.warnings), quality=quality)
+    return PendingRender(future, method, width, height, list(scene_data.warnings), quality=quality, output=output)
+
+
+def output_file(path: str) -> str:
+    """The absolute EXR path the Output setting names ("" when it is empty): `//` is relative to the .blend, a
+    name without extension gets `.exr`. PreviewError for a path that cannot name an EXR file."""
+    path = path.strip()
+    if not path:
+        return ""
+    if path.startswith("//") and not bpy.data.filepath:
+        raise PreviewError(f"Output {path} is relative to the .blend file, which is not saved yet: save it first "
+                           "or choose an absolute path")
+    resolved = os.path.abspath(bpy.path.abspath(path))
+    if path.endswith(("/", "\\")) or os.path.isdir(resolved):
+        raise PreviewError(f"Output {path} is a folder: give a file name, e.g. "
+                           f"{os.path.join(resolved, 'bounce_gi.exr')}")
+    suffix = os.path.splitext(resolved)[1]
+    if not suffix:
+        return resolved + ".exr"
+    if suffix.lower() != ".exr":
+        raise PreviewError(f"Output {path} must be an .exr file (the passes are written as a multi-layer EXR)")
+    return resolved
+
+
+def write_output(path: str, passes: dict) -> None:
+    """Write the render passes as a multi-layer EXR, creating its folder as Blender does for render output."""
+    from ..gpu_kernels.output.exr import write_passes
+
+    try:
+        os.makedirs(os.path.dirname(path), exist_ok=True)
+        write_passes(path, passes)
+    except ImportError as ex:
+        raise PreviewError(f"Bounce GI could not write {path}: EXR support unavailable ({one_line(ex)})") from None
+    except OSError as ex:  # strerror, where there is one: the temporary file's name would only confuse
+        raise PreviewError(f"Bounce GI could not write {path}: {ex.strerror or one_line(ex)}") from None
+    except Exception as ex:
+        raise _unexpected(ex, f"writing {path}") from None
 
 
 def budget_settings(budget_ms: float, width: int, height: int):
@@ -150,7 +191,8 @@ def budget_settings(budget_ms: float, width: int, height: int):
 
 
 def finish_render(pending: PendingRender, timeout: float | None = None) -> RenderReport:
-    """Wait for the engine, write the Combined pass into the preview image, record the report."""
+    """Wait for the engine, write the Combined pass into the preview image, record the report, write the passes
+    to the Output file if one is set."""
     import concurrent.futures
 
     try:
@@ -174,6 +216,10 @@ def finish_render(pending: PendingRender, timeout: float | None = None) -> Rende
     report = RenderReport(pending.method, pending.width, pending.height, dict(result.timings), warnings,
                           pending.elapsed(), list(getattr(result, "skipped", [])), pending.quality)
     state.last, state.last_error = report, None
+    if pending.output:
+        # After the preview is shown and recorded: a failed write is reported, the image and times stay.
+        write_output(pending.output, result.passes)
+        report.output = pending.output
     return report
 
 

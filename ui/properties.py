@@ -1,6 +1,6 @@
 """Per-scene settings, stored in the .blend as `bpy.types.Scene.bounce_gi`.
 
-Only user choices live here. Results of the last render are runtime state (see operators.py)
+Only user choices live here. Results of the last render are runtime state (see preview.py)
 so that a preview never dirties or bloats the file.
 """
 import bpy
@@ -14,9 +14,13 @@ METHOD_ITEMS = (
     ("VCT", "Voxel Cone Tracing", "Indirect light gathered by tracing cones through a voxel mip chain"),
 )
 
+# Blender 4.5+ warns when a path property without this flag is given a "//" (relative to the .blend) path; older
+# versions do not know the flag. ANIMATABLE is the default the options replace.
+PATH_OPTIONS = {"ANIMATABLE", "PATH_SUPPORTS_BLEND_RELATIVE"} if bpy.app.version >= (4, 5, 0) else {"ANIMATABLE"}
+
 
 class BounceGISettings(PropertyGroup):
-    """What the Render Preview operator renders and where batch renders are written."""
+    """What the Render Preview operator renders, and where it writes the render passes."""
 
     method: EnumProperty(
         name="Method",
@@ -50,9 +54,11 @@ class BounceGISettings(PropertyGroup):
     )
     output_path: StringProperty(
         name="Output",
-        description="Multi-layer EXR file for the render passes (// is relative to the .blend)",
+        description="Multi-layer EXR file the Render Preview also writes its render passes to (// is relative to "
+                    "the .blend); leave empty to only show the preview image",
         subtype="FILE_PATH",
-        default="//bounce_gi.exr",
+        options=PATH_OPTIONS,
+        default="",
     )
 
     def method_id(self) -> str:
