@@ -1,4 +1,4 @@
-"""The example scenes (examples/scenes.py): every scene builds, has one camera, light,
+"""The example scenes (examples/scenes/): every scene builds, has one camera, light,
 the expected objects and settings; one .blend round-trips; Cycles lights `cornell`.
 
 bpy work runs in ONE subprocess (this file run as a script with --collect), so Blender
@@ -39,12 +39,10 @@ EXPECTED_COUNTS = {
 # --------------------------------------------------------------------------- subprocess side
 
 
-def _summarize(bpy, name):
-    """Plain-data description of the current scene."""
+def _lights(bpy, objs):
+    """Light data per light object: type, energy, colour, placement and the type's own settings."""
     from mathutils import Vector
 
-    scene = bpy.context.scene
-    objs = list(bpy.data.objects)
     lights = {}
     for ob in objs:
         if ob.type != "LIGHT":
@@ -60,6 +58,11 @@ def _summarize(bpy, name):
         if ld.type == "AREA":
             info.update(shape=ld.shape, size=ld.size)
         lights[ob.name] = info
+    return lights
+
+
+def _materials(bpy):
+    """(names of emissive materials, node types per material)."""
     emissive = []
     node_types = {}
     for mat in bpy.data.materials:
@@ -68,23 +71,56 @@ def _summarize(bpy, name):
         for n in mat.node_tree.nodes:
             if n.bl_idname == "ShaderNodeEmission" and n.inputs["Strength"].default_value > 0:
                 emissive.append(mat.name)
+    return emissive, node_types
+
+
+def _camera(scene):
+    from mathutils import Vector
+
+    cam_ob = scene.camera
+    cam = cam_ob.data
+    m = cam_ob.matrix_world.to_3x3()
+    return dict(name=cam_ob.name, type=cam.type, lens=cam.lens, sensor_fit=cam.sensor_fit,
+                shift=(cam.shift_x, cam.shift_y), ortho_scale=cam.ortho_scale,
+                location=tuple(cam_ob.location), view=tuple(m @ Vector((0, 0, -1))),
+                right=tuple(m @ Vector((1, 0, 0))), up=tuple(m @ Vector((0, 1, 0))))
+
+
+def _extraction(bpy, objs):
+    """What the `extraction` scene sets up: modifiers, the excluded collection and its instances, custom normals."""
+    blob = bpy.data.objects["Blob"]
+    dg = bpy.context.evaluated_depsgraph_get()
+    me = bpy.data.objects["CustomNormals"].data
+    return dict(
+        modifiers=[(md.type, getattr(md, "levels", None), getattr(md, "render_levels", None))
+                   for md in blob.modifiers],
+        props_excluded=bpy.context.view_layer.layer_collection.children["Props"].exclude,
+        props_objects=sorted(o.name for o in bpy.data.collections["Props"].objects),
+        empties=[(o.instance_type, o.instance_collection.name if o.instance_collection else None)
+                 for o in objs if o.type == "EMPTY"],
+        instances=sorted(i.object.name for i in dg.object_instances if i.is_instance),
+        has_custom_normals=me.has_custom_normals,
+        corner_normals=[tuple(c.vector) for c in me.corner_normals],
+    )
+
+
+def _summarize(bpy, name):
+    """Plain-data description of the current scene."""
+    scene = bpy.context.scene
+    objs = list(bpy.data.objects)
+    lights = _lights(bpy, objs)
+    emissive, node_types = _materials(bpy)
     # Polygon normals of named quads (world space), to check walls face inward.
     normals = {}
     for ob in objs:
         if ob.type == "MESH" and len(ob.data.polygons) <= 4 and not ob.modifiers:
             n = ob.matrix_world.to_3x3() @ ob.data.polygons[0].normal
             normals[ob.name] = tuple(round(c, 4) for c in n)
-    cam_ob = scene.camera
-    cam = cam_ob.data
-    m = cam_ob.matrix_world.to_3x3()
     world_bg = scene.world.node_tree.nodes["Background"] if scene.world else None
     out = dict(
         objects={ob.name: ob.type for ob in objs},
         n_cameras=sum(ob.type == "CAMERA" for ob in objs),
-        camera=dict(name=cam_ob.name, type=cam.type, lens=cam.lens, sensor_fit=cam.sensor_fit,
-                    shift=(cam.shift_x, cam.shift_y), ortho_scale=cam.ortho_scale,
-                    location=tuple(cam_ob.location), view=tuple(m @ Vector((0, 0, -1))),
-                    right=tuple(m @ Vector((1, 0, 0))), up=tuple(m @ Vector((0, 1, 0)))),
+        camera=_camera(scene),
         resolution=(scene.render.resolution_x, scene.render.resolution_y,
                     scene.render.resolution_percentage),
         world_strength=world_bg.inputs["Strength"].default_value if world_bg else None,
@@ -97,20 +133,7 @@ def _summarize(bpy, name):
                 for im in bpy.data.images},
     )
     if name == "extraction":
-        blob = bpy.data.objects["Blob"]
-        dg = bpy.context.evaluated_depsgraph_get()
-        me = bpy.data.objects["CustomNormals"].data
-        out["extraction"] = dict(
-            modifiers=[(md.type, getattr(md, "levels", None), getattr(md, "render_levels", None))
-                       for md in blob.modifiers],
-            props_excluded=bpy.context.view_layer.layer_collection.children["Props"].exclude,
-            props_objects=sorted(o.name for o in bpy.data.collections["Props"].objects),
-            empties=[(o.instance_type, o.instance_collection.name if o.instance_collection else None)
-                     for o in objs if o.type == "EMPTY"],
-            instances=sorted(i.object.name for i in dg.object_instances if i.is_instance),
-            has_custom_normals=me.has_custom_normals,
-            corner_normals=[tuple(c.vector) for c in me.corner_normals],
-        )
+        out["extraction"] = _extraction(bpy, objs)
     return out
 
 
