@@ -1,4 +1,4 @@
-"""gpu_kernels.exr_io: multi-part EXR in Blender 5's layout (design.md §3), atomic writes, reading real Blender
+"""gpu_kernels.output.exr: multi-part EXR in Blender 5's layout (design.md §3), atomic writes, reading real Blender
 output, and the sRGB preview tone map."""
 import math
 import os

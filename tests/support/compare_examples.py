@@ -1,6 +1,7 @@
 """Render example scenes with Bounce GI and with Cycles (two seeds) and print one JSON line of errors.
 
-Run in a subprocess by tests/test_direct_vs_cycles.py so bpy's global state stays out of the pytest process:
+Run in a subprocess by the `compare_examples` fixture (tests/conftest.py) for tests/accuracy/, so bpy's global state
+stays out of the pytest process:
     python tests/support/compare_examples.py SAMPLES NAME [NAME...] [--method lpv|vct] [--bounces N]
                                              [--lpv KEY=VALUE ...] [--vct KEY=VALUE ...]
 """
