@@ -18,15 +18,23 @@ def write_uniform(prog, name, array: np.ndarray) -> None:
         prog[name].write(np.ascontiguousarray(array, np.float32).tobytes())
 
 
-def bind_samplers(prog, name: str, textures: list, first: int) -> int:
-    """Bind `textures` to consecutive texture units from `first` and point sampler (array) `name` at them;
-    returns the next free unit."""
+def bind_samplers(prog, name: str, textures: list, first: int, pad_to: int = 0) -> int:
+    """Bind `textures` to consecutive texture units from `first` and point sampler (array) `name` at them, the
+    array's unused tail (up to `pad_to` entries) at the last one; returns the next free unit."""
     for i, t in enumerate(textures):
         t.use(location=first + i)
     if name in prog:
         units = list(range(first, first + len(textures)))
+        units += units[-1:] * (pad_to - len(units))
         prog[name].value = units if prog[name].array_length > 1 else units[0]
     return first + len(textures)
+
+
+def bind_named(prog, samplers: list, first: int = 0) -> int:
+    """bind_samplers for (sampler name, texture) pairs on consecutive units; returns the next free unit."""
+    for name, texture in samplers:
+        first = bind_samplers(prog, name, [texture], first)
+    return first
 
 
 def bind_images(textures: list, first: int = 0, read: bool = False, write: bool = True, level: int = 0) -> int:
@@ -64,10 +72,15 @@ def bind_lights(prog, shadows, unit: int) -> int:
     set_uniform(prog, "u_shadow_atlas", unit)
     set_uniform(prog, "u_atlas_texel", (1.0 / shadows.size[0], 1.0 / shadows.size[1]))
     set_uniform(prog, "u_light_count", shadows.light_count)
+    bind_light_records(shadows)
+    return unit + 1
+
+
+def bind_light_records(shadows) -> None:
+    """The light, shadow-view and polygon records of common/lights.glsl on storage buffers 0, 1, 2."""
     shadows.light_ssbo.bind_to_storage_buffer(0)
     shadows.view_ssbo.bind_to_storage_buffer(1)
     shadows.polygon_ssbo.bind_to_storage_buffer(2)
-    return unit + 1
 
 
 def ssbo(ctx, array: np.ndarray):

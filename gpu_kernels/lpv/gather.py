@@ -23,7 +23,7 @@ import numpy as np
 
 from ..common.bounce_tail import tail_ratio, tail_sum
 from ..common.grid import Grid
-from ..gl.bind import bind_grid, dispatch, set_uniform, zero_texture
+from ..gl.bind import bind_grid, bind_light_records, bind_named, dispatch, set_uniform, zero_texture
 from .occlusion import absorb
 from .propagate import propagate
 from .settings import LpvSettings
@@ -53,17 +53,11 @@ class VplList:
 
 def rsm_uniforms(prog, rsm, shadows, downsample: int) -> tuple:
     """Bind what lpv/inject.glsl reads of the RSM and the lights; returns the atlas size in k×k blocks."""
-    for unit, tex in enumerate((rsm.position, rsm.normal, rsm.albedo)):
-        tex.use(location=unit)
-    set_uniform(prog, "u_rsm_position", 0)
-    set_uniform(prog, "u_rsm_normal", 1)
-    set_uniform(prog, "u_rsm_albedo", 2)
+    bind_named(prog, [("u_rsm_position", rsm.position), ("u_rsm_normal", rsm.normal), ("u_rsm_albedo", rsm.albedo)])
     set_uniform(prog, "u_rsm_size", rsm.size)
     set_uniform(prog, "u_rsm_resolution", int(rsm.resolution))
     set_uniform(prog, "u_downsample", int(downsample))
-    shadows.light_ssbo.bind_to_storage_buffer(0)
-    shadows.view_ssbo.bind_to_storage_buffer(1)
-    shadows.polygon_ssbo.bind_to_storage_buffer(2)
+    bind_light_records(shadows)
     rsm.views_ssbo.bind_to_storage_buffer(3)
     return (rsm.size[0] + downsample - 1) // downsample, (rsm.size[1] + downsample - 1) // downsample
 
@@ -141,11 +135,8 @@ def bounce_vpls(ctx, programs, state: LpvGridState, gv, budget: int) -> VplList:
     """The light the surface voxels reflect (albedo × last pass's irradiance × area, per side) as at most `budget`
     VPLs: S×S×S voxel blocks, up to three per block split by plane (lpv/cluster.glsl), S from 2 up."""
     prog = programs.compute("lpv/cluster.glsl")
-    for unit, (name, tex) in enumerate((("u_front", state.front), ("u_back", state.back),
-                                        ("u_voxel_normal", gv.normal), ("u_voxel_area", gv.area),
-                                        ("u_voxel_albedo", gv.albedo))):
-        tex.use(location=unit)
-        set_uniform(prog, name, unit)
+    bind_named(prog, [("u_front", state.front), ("u_back", state.back), ("u_voxel_normal", gv.normal),
+                      ("u_voxel_area", gv.area), ("u_voxel_albedo", gv.albedo)])
     set_uniform(prog, "u_fine_origin", tuple(float(c) for c in gv.fine.origin))
     set_uniform(prog, "u_fine_size", tuple(gv.fine.size))
     set_uniform(prog, "u_voxel", float(gv.fine.cell))
@@ -187,10 +178,8 @@ def gather(ctx, programs, state: LpvGridState, gv, vpls: VplList, occlusion: boo
     if vpls.count == 0:
         return
     prog = programs.compute("lpv/gather.glsl")
-    for unit, (name, tex) in enumerate((("u_voxel_normal", gv.normal), ("u_voxel_area", gv.area),
-                                        ("u_coverage", gv.coverage), ("u_layers", gv.layers))):
-        tex.use(location=unit)
-        set_uniform(prog, name, unit)
+    bind_named(prog, [("u_voxel_normal", gv.normal), ("u_voxel_area", gv.area), ("u_coverage", gv.coverage),
+                      ("u_layers", gv.layers)])
     set_uniform(prog, "u_occlusion", bool(occlusion))
     set_uniform(prog, "u_fine_origin", tuple(float(c) for c in gv.fine.origin))
     bind_grid(prog, state.grid)

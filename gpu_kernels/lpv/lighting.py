@@ -2,7 +2,7 @@
 irradiance (the flux lookup) or the SH intensity convolved with the cosine (Kaplanyan's lookup)."""
 from __future__ import annotations
 
-from ..gl.bind import dispatch, set_uniform
+from ..gl.bind import bind_named, bind_samplers, dispatch, set_uniform
 from .settings import LpvSettings
 
 
@@ -13,11 +13,7 @@ def lighting(ctx, programs, gbuffer, states: list, gvs: list, settings: LpvSetti
     flux_mode = settings.lookup == "flux" and all(g is not None for g in gvs)
     prog = programs.compute("lpv/lighting.glsl", {"MODE_FLUX": 1} if flux_mode else None)
     out.bind_to_image(0, read=False, write=True)
-    gbuffer.textures["position"].use(location=0)
-    gbuffer.textures["normal"].use(location=1)
-    set_uniform(prog, "u_position", 0)
-    set_uniform(prog, "u_normal", 1)
-    unit = 2
+    unit = bind_named(prog, [("u_position", gbuffer.textures["position"]), ("u_normal", gbuffer.textures["normal"])])
     n = len(states)
     per_cascade = {f"u_accum_{c}": [s.accum.textures()[i] for s in states] for i, c in enumerate("rgb")}
     if flux_mode:
@@ -27,13 +23,7 @@ def lighting(ctx, programs, gbuffer, states: list, gvs: list, settings: LpvSetti
         set_uniform(prog, "u_fine_origin", fine_origin + [fine_origin[-1]] * (4 - n))
         set_uniform(prog, "u_fine_size", [tuple(g.fine.size) for g in gvs] + [(1, 1, 1)] * (4 - n))
     for name, texs in per_cascade.items():
-        units = []
-        for tex in texs:
-            tex.use(location=unit)
-            units.append(unit)
-            unit += 1
-        units += [units[-1]] * (4 - n)
-        set_uniform(prog, name, units)
+        unit = bind_samplers(prog, name, texs, unit, pad_to=4)
     origins = [tuple(float(c) for c in s.grid.origin) for s in states]
     set_uniform(prog, "u_grid_origin", origins + [origins[-1]] * (4 - n))
     set_uniform(prog, "u_grid_cell", [float(s.grid.cell) for s in states] + [1.0] * (4 - n))

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..common.grid import Grid
-from ..gl.bind import bind_grid, dispatch, set_uniform
+from ..gl.bind import bind_grid, bind_images, bind_named, dispatch, set_uniform
 from ..scene import Scene
 from .state import FIXED_RANGE, LpvGridState, resolve
 
@@ -152,16 +152,10 @@ def absorb(ctx, programs, state: LpvGridState, gv: GeometryVolume, add: bool) ->
             setattr(state, name, t)
     prog = programs.compute("lpv/absorb.glsl", {"MODE_ADD": 1} if add else None)
     state.face_flux.bind_to_storage_buffer(6)
-    gv.blocking.use(location=0)
-    gv.normal.use(location=1)
-    gv.area.use(location=2)
-    set_uniform(prog, "u_geometry", 0)
-    set_uniform(prog, "u_voxel_normal", 1)
-    set_uniform(prog, "u_voxel_area", 2)
+    bind_named(prog, [("u_geometry", gv.blocking), ("u_voxel_normal", gv.normal), ("u_voxel_area", gv.area)])
     set_uniform(prog, "u_grid_size", tuple(int(c) for c in state.grid.size))
     set_uniform(prog, "u_grid_cell", float(state.grid.cell))
-    for unit, name in enumerate(("front", "back", "front_total", "back_total")):
-        getattr(state, name).bind_to_image(unit, read=True, write=True)
+    bind_images([state.front, state.back, state.front_total, state.back_total], read=True)
     dispatch(prog, size)
 
 
@@ -170,11 +164,8 @@ def inject_bounce(ctx, programs, state: LpvGridState, gv: GeometryVolume, bound:
     scale = FIXED_RANGE / max(bound, 1e-12)
     state.accum_ints.clear()
     prog = programs.compute("lpv/bounce.glsl")
-    for unit, (name, tex) in enumerate((("u_front", state.front), ("u_back", state.back),
-                                        ("u_voxel_normal", gv.normal), ("u_voxel_area", gv.area),
-                                        ("u_voxel_albedo", gv.albedo))):
-        tex.use(location=unit)
-        set_uniform(prog, name, unit)
+    bind_named(prog, [("u_front", state.front), ("u_back", state.back), ("u_voxel_normal", gv.normal),
+                      ("u_voxel_area", gv.area), ("u_voxel_albedo", gv.albedo)])
     set_uniform(prog, "u_fine_origin", tuple(float(c) for c in gv.fine.origin))
     set_uniform(prog, "u_fine_size", tuple(gv.fine.size))
     bind_grid(prog, state.grid)

@@ -22,7 +22,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..common.grid import Grid
-from ..gl.bind import dispatch, set_uniform
+from ..gl.bind import bind_images, bind_named, bind_samplers, dispatch, set_uniform
 from .occlusion import face_blocking
 from .propagate import propagate
 from .settings import LpvSettings
@@ -140,11 +140,8 @@ def downsample(ctx, programs, state0: LpvGridState, geo: OctreeGeometry) -> Octr
     levels = [state0]
     for g in geo.grids[1:]:
         src, dst = levels[-1], LpvGridState(ctx, g)
-        for unit, (name, tex) in enumerate(zip(("u_src_r", "u_src_g", "u_src_b"), src.injected.textures())):
-            tex.use(location=unit)
-            set_uniform(prog, name, unit)
-        for unit, tex in enumerate(dst.injected.textures()):
-            tex.bind_to_image(unit, read=False, write=True)
+        bind_named(prog, list(zip(("u_src_r", "u_src_g", "u_src_b"), src.injected.textures())))
+        bind_images(dst.injected.textures())
         set_uniform(prog, "u_src_size", tuple(int(c) for c in src.grid.size))
         set_uniform(prog, "u_dst_size", tuple(int(c) for c in g.size))
         dispatch(prog, g.size)
@@ -212,12 +209,7 @@ def merge(ctx, programs, tree: OctreeState, geo: OctreeGeometry) -> MergedState:
     unit = 0
     for name, texs in (("u_level_r", [s.accum.r for s in tree.levels]), ("u_level_g", [s.accum.g for s in tree.levels]),
                        ("u_level_b", [s.accum.b for s in tree.levels]), ("u_index", geo.index_textures)):
-        units = []
-        for tex in texs:
-            tex.use(location=unit)
-            units.append(unit)
-            unit += 1
-        set_uniform(prog, name, units + [units[-1]] * (MAX_LEVELS - l))
+        unit = bind_samplers(prog, name, texs, unit, pad_to=MAX_LEVELS)
     for unit, tex in enumerate(merged.accum.textures()):
         tex.bind_to_image(unit, read=False, write=True)
     merged.index.bind_to_image(3, read=False, write=True)

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..common.grid import Grid
-from ..gl.bind import dispatch, set_uniform
+from ..gl.bind import bind_images, bind_named, dispatch, set_uniform, write_uniform
 from .occlusion import absorb, inject_bounce
 from .settings import LpvSettings
 from .sh import SH_FLUX, transfer_matrices
@@ -30,8 +30,8 @@ def propagate(ctx, programs, state: LpvGridState, source: Volumes, injected_flux
     transfer, incident = transfer_matrices()
     if "u_transfer" in prog:
         # GLSL mat4 is column-major: pass each matrix transposed.
-        prog["u_transfer"].write(np.ascontiguousarray(transfer.transpose(0, 2, 1)).tobytes())
-        prog["u_incident"].write(incident.tobytes())
+        write_uniform(prog, "u_transfer", transfer.transpose(0, 2, 1))
+        write_uniform(prog, "u_incident", incident)
     if gv_texture is not None:
         gv_texture.use(location=3)
     set_uniform(prog, "u_geometry", 3)
@@ -40,13 +40,9 @@ def propagate(ctx, programs, state: LpvGridState, source: Volumes, injected_flux
     state.face_flux.bind_to_storage_buffer(6)
     moved_history = []
     for step in range(settings.max_iterations):
-        for unit, (name, tex) in enumerate(zip(("u_src_r", "u_src_g", "u_src_b"), src.textures())):
-            tex.use(location=unit)
-            set_uniform(prog, name, unit)
-        for unit, tex in enumerate(dst.textures()):
-            tex.bind_to_image(unit, read=False, write=True)
-        for unit, tex in enumerate(state.accum.textures()):
-            tex.bind_to_image(3 + unit, read=True, write=True)
+        bind_named(prog, list(zip(("u_src_r", "u_src_g", "u_src_b"), src.textures())))
+        bind_images(dst.textures())
+        bind_images(state.accum.textures(), 3, read=True)
         check = (step + 1) % CHECK_EVERY == 0 or step + 1 == settings.max_iterations
         if check:
             state.counter.write(np.zeros(1, np.int32).tobytes())

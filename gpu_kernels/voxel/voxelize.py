@@ -24,7 +24,7 @@ import numpy as np
 from ..common.grid import Grid
 from ..direct.geometry import bind_material
 from ..gl import preprocessor as spp
-from ..gl.bind import dispatch, set_uniform
+from ..gl.bind import bind_images, bind_named, dispatch, set_uniform
 from ..scene import Scene
 
 MODES = ("raster", "tessellation")
@@ -324,11 +324,8 @@ def _resolve(ctx, programs, accs, grid, scale_bits, albedo_max, emission_max) ->
     prog = programs.compute("voxel/resolve.glsl", {"MODE_RESOLVE": None})
     nx, ny, nz = grid.size
     out = [ctx.texture3d((nx, ny, nz), 4, dtype="f4") for _ in VOLUME_NAMES]
-    for unit, (acc, name) in enumerate(zip(accs, ("u_acc_area", "u_acc_albedo", "u_acc_normal", "u_acc_emission"))):
-        acc.use(location=unit)
-        set_uniform(prog, name, unit)
-    for unit, tex in enumerate(out):
-        tex.bind_to_image(unit, read=False, write=True)
+    bind_named(prog, list(zip(("u_acc_area", "u_acc_albedo", "u_acc_normal", "u_acc_emission"), accs)))
+    bind_images(out)
     cell_area = grid.cell ** 2
     for name, value in {"u_grid_size": grid.size, "u_unit_area": cell_area / 2.0 ** scale_bits, "u_cell_area": cell_area,
                         "u_albedo_max": albedo_max, "u_emission_max": emission_max}.items():
