@@ -229,3 +229,33 @@ def test_modal_path_with_simulated_events(tmp_path):
         import concurrent.futures   # cancelled if still queued, else let it finish before exiting
         concurrent.futures.wait([op._pending.future], timeout=120)
     """)
+
+
+def test_output_setting_writes_the_passes(tmp_path):
+    """The panel's Output setting: the preview's passes land in that multi-layer EXR (Combined equal to the
+    preview image, every pass written); a folder or a non-EXR name is one error line and writes nothing."""
+    out = tmp_path / "renders" / "preview"  # no extension: .exr is added; the folder is created
+    run_case(tmp_path, setup=TINY_SCENE, body=f"""
+        import os
+        from bounce_gi.gpu_kernels.compose import PASS_NAMES
+        from bounce_gi.gpu_kernels.output.exr import read_passes
+        scene.bounce_gi.output_path = {str(out)!r}
+        print("operator", bpy.ops.bounce_gi.render_preview())
+        passes = read_passes({str(out) + ".exr"!r})
+        img = bpy.data.images["Bounce GI Preview"]
+        px = np.empty(img.size[0] * img.size[1] * 4, np.float32); img.pixels.foreach_get(px)
+        px = px.reshape(img.size[1], img.size[0], 4)[::-1]  # Blender's rows are bottom-up
+        print("passes", sorted(passes), "combined", passes["Combined"].shape)
+        assert set(PASS_NAMES) <= set(passes)
+        assert np.array_equal(passes["Combined"][..., :3], px[..., :3])  # the same float32 values, not a copy
+        for bad in ({str(tmp_path)!r}, {str(tmp_path / "x.png")!r}):
+            scene.bounce_gi.output_path = bad
+            try:
+                bpy.ops.bounce_gi.render_preview()
+            except RuntimeError as ex:
+                print("bad output:", ex)
+                assert "Output" in str(ex) and str(ex).count("\\n") <= 1
+            else:
+                raise AssertionError(f"Output {{bad}} was accepted")
+        assert not os.path.exists({str(tmp_path / "x.png")!r})
+    """)
