@@ -7,7 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..common import camera as cam
-from ..gl.bind import set_uniform
+from ..gl.bind import set_uniform, write_uniform
 from ..scene import Scene
 from .geometry import GeometryBuffers, draw_by_material
 
@@ -55,7 +55,7 @@ def render_gbuffer(ctx, programs, scene: Scene, geometry: GeometryBuffers, textu
     prog = programs.raster("direct/gbuffer.glsl")
     cam_world = np.asarray(camera.matrix_world, np.float64)
     forward = -cam_world[:3, 2] / np.linalg.norm(cam_world[:3, 2])
-    prog["u_view_projection"].write((proj @ view).T.astype("f4").tobytes())
+    write_uniform(prog, "u_view_projection", (proj @ view).T)
     set_uniform(prog, "u_camera_position", tuple(cam_world[:3, 3]))
     set_uniform(prog, "u_camera_forward", tuple(forward))
     set_uniform(prog, "u_camera_ortho", camera.type == "ORTHO")

@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ..common import lights as lb
-from ..gl.bind import ssbo
+from ..gl.bind import set_uniform, ssbo, write_uniform
 from ..scene import Scene
 from .geometry import GeometryBuffers
 
@@ -51,9 +51,9 @@ def render_shadow_atlas(ctx, programs, scene: Scene, geometry: GeometryBuffers,
         prog = programs.raster("direct/shadow_depth.glsl")
         for view, (x, y, w, h) in zip(buffers.views, tiles):
             fbo.viewport = (x, y, w, h)
-            prog["u_view_projection"].write(view.view_projection.T.astype("f4").tobytes())
-            prog["u_origin"].value = tuple(float(c) for c in view.origin)
-            prog["u_far"].value = float(view.far)
+            write_uniform(prog, "u_view_projection", view.view_projection.T)
+            set_uniform(prog, "u_origin", tuple(float(c) for c in view.origin))
+            set_uniform(prog, "u_far", float(view.far))
             geometry.vao_depth.render(moderngl.TRIANGLES)
         fbo.release()
     views = lb.pack_views(buffers.views, tiles, size, settings.pcf_radius, buffers.view_lights)

@@ -9,7 +9,7 @@ import numpy as np
 
 from ..common import lights as lb
 from ..direct.geometry import draw_by_material
-from ..gl.bind import set_uniform, ssbo
+from ..gl.bind import set_uniform, ssbo, write_uniform
 from ..scene import Scene
 
 
@@ -77,7 +77,7 @@ def render_rsm(ctx, programs, scene: Scene, geometry, textures, shadows, resolut
     records = np.zeros(len(views), RSM_VIEW_DTYPE)
     for i, (view, (x, y, w, h)) in enumerate(zip(views, tiles)):
         fbo.viewport = (x, y, w, h)
-        prog["u_view_projection"].write(view.view_projection.T.astype("f4").tobytes())
+        write_uniform(prog, "u_view_projection", view.view_projection.T)
         right, back = view.view_matrix[0, :3], view.view_matrix[2, :3]  # rows of world → view: right, up, back
         set_uniform(prog, "u_origin", tuple(float(c) for c in view.origin))
         set_uniform(prog, "u_forward", tuple(float(c) for c in -back))
