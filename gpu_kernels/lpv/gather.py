@@ -1,7 +1,7 @@
 """The LPV's gathered transport (LpvSettings.transport = "gather", the default): light goes straight from lists of
 VPLs to the surface voxels of the geometry volume, with fuzzy visibility through it (lpv/gather.glsl), instead of
-through the Kaplanyan–Dachsbacher propagation. The VPLs are instant radiosity's (Keller 1997); the traversal of
-lpv/gather.glsl visits cells in the order of Amanatides and Woo 1987.
+through the Kaplanyan–Dachsbacher propagation. The VPLs are instant radiosity's (Keller 1997); lpv/gather.glsl walks the
+cells between a VPL and a voxel with the traversal of Amanatides and Woo 1987.
 
 Why: the face scheme re-emits, at every cell, what each face received as a cosine lobe toward that face; a lobe
 pointing up keeps only 0.096 of its flux going up (the rest turns sideways), so light from a lit floor returns to

@@ -1,5 +1,5 @@
 """LPV injection: RSM texels as VPLs and world light at the grid's open border, summed in fixed point into each
-cascade's SH volumes (Kaplanyan and Dachsbacher 2010, §injection)."""
+cascade's SH volumes (Kaplanyan and Dachsbacher 2010: light injection)."""
 from __future__ import annotations
 
 import math

@@ -1,5 +1,5 @@
 """Two-band spherical harmonics and the Kaplanyan–Dachsbacher face scheme as linear maps (Kaplanyan and
-Dachsbacher 2010, "Cascaded Light Propagation Volumes for Real-Time Indirect Illumination", §propagation)."""
+Dachsbacher 2010, "Cascaded Light Propagation Volumes for Real-Time Indirect Illumination": propagation)."""
 from __future__ import annotations
 
 import math

@@ -1,5 +1,5 @@
 """vct_mipmap: the filtered cone volumes built from the face radiances, level by level (isotropic: the mean of
-the children; anisotropic: six directions composited front to back, Crassin et al. 2011 §anisotropic voxels),
+the children; anisotropic: six directions composited front to back, Crassin et al. 2011's anisotropic voxels),
 and the layer volume that says where each texel's surfaces lie along each axis."""
 from __future__ import annotations
 

@@ -2,12 +2,14 @@
 along the reflected view direction → the Glossy Indirect pass (vct/specular.glsl).
 
 Aperture: Blender's GGX has α = roughness². Half of the GGX microfacet normals lie within atan(α) of the normal
-(GGX sampling: tan²θ_h = α²ξ/(1 − ξ), median at ξ = ½), and the reflected ray turns by twice the normal's tilt, so
-the cone's half-angle is 2·atan(α) — the median of the reflected lobe — capped at 45°. `aperture_deg` gives it.
+(GGX sampling, Walter et al. 2007: tan²θ_h = α²ξ/(1 − ξ), median at ξ = ½), and the reflected ray turns by twice
+the normal's tilt, so the cone's half-angle is 2·atan(α) — the median of the reflected lobe — capped at 45°.
+`aperture_deg` gives it.
 Pixels rougher than VctSettings.roughness_cutoff, or with no glossy closure (Glossy Color 0), run no cone and get 0,
 so a scene without glossy materials pays one texture fetch per pixel (measured in benchmarks/vct_bench.py).
-Glossy Color comes from the G-buffer (direct/gbuffer.glsl: Cycles' glossy albedo); Combined adds Glossy Indirect × Glossy
-Color (compose.compose_passes). Specular light from the lights themselves (Cycles' Glossy Direct) is not computed.
+Glossy Color comes from the G-buffer (direct/gbuffer.glsl: Cycles' glossy albedo); Combined adds Glossy Indirect ×
+Glossy Color (compose.compose_passes). Specular light from the lights themselves (Cycles' Glossy Direct) is not
+computed.
 """
 from __future__ import annotations
 

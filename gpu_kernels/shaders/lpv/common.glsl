@@ -2,7 +2,8 @@
 // conventions: docs/conventions.md; the clamped-cosine coefficients are Ramamoorthi and Hanrahan 2001's.
 #pragma once
 
-// Basis: Y00 = 0.282095, Y1-1 = −0.488603·y, Y10 = 0.488603·z, Y11 = −0.488603·x.
+// Basis (real SH with Sloan 2008's sign convention): Y00 = 0.282095, Y1-1 = −0.488603·y, Y10 = 0.488603·z,
+// Y11 = −0.488603·x.
 vec4 sh_basis(vec3 d) {
     return vec4(0.282094792, -0.488602512 * d.y, 0.488602512 * d.z, -0.488602512 * d.x);
 }
