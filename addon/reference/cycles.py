@@ -1,4 +1,4 @@
-"""Cycles ground truth: two-seed reference renders with the settings of design.md §3, cached by content hash.
+"""Cycles ground truth: two-seed reference renders with the settings of docs/conventions.md (Cycles references), cached by content hash.
 
 Settings: CPU, adaptive sampling off, denoising off, clamps 0, light threshold 0, pixel filter 0.01 px (so Cycles
 samples pixel centres like our rasteriser), fixed bounce counts. The mean of the two seeds is the reference; half
@@ -89,7 +89,7 @@ def configure_cycles(scene, view_layer, settings: ReferenceSettings, seed: int, 
     c.use_adaptive_sampling = False
     c.use_denoising = False
     c.sample_clamp_direct = 0.0
-    c.sample_clamp_indirect = 0.0  # defaults to 10: turn it off (design.md §3)
+    c.sample_clamp_indirect = 0.0  # defaults to 10: turn it off (docs/conventions.md)
     c.light_sampling_threshold = 0.0
     c.filter_width = 0.01
     c.seed = seed

@@ -8,7 +8,7 @@ Units are metres, Z up. Every scene has exactly one camera, renders at
     scenes.build("cornell")            # replaces the current bpy data
     scenes.save("cornell", "/tmp/cornell.blend")
 
-Materials are Diffuse BSDF (exact albedo, design.md section 3) with the
+Materials are Diffuse BSDF (exact albedo, docs/conventions.md, Materials) with the
 viewport display colour set to the same albedo, unless a scene says
 otherwise. Image textures are generated in code and packed into the .blend.
 

@@ -1,6 +1,6 @@
 """Direct light and Diffuse Color against Cycles, per light type and camera kind (issue: foundation).
 
-Each scene is rendered at 160×120 by Bounce GI and by Cycles (two seeds, 128 spp, settings of design.md §3).
+Each scene is rendered at 160×120 by Bounce GI and by Cycles (two seeds, 128 spp, settings of docs/conventions.md).
 Tolerances are the claims:
 - Diffuse Direct rel-L1 ≤ 3% per light type. Our light units and falloffs are exact (they match Cycles to 1e-4
   on unshadowed surfaces), so what remains is shadow filtering (PCF edges one texel wide), polygon-light penumbrae

@@ -73,7 +73,7 @@ def test_quick_report_shape(quick):
     for method in ("none", "lpv", "vct"):
         defaults = [r for r in scene["rows"] if r["method"] == method and r["default"]]
         assert len(defaults) == 1, method
-    from bounce_gi.addon.bench import default_settings
+    from bounce_gi.addon.bench.sweep import default_settings
 
     for r in scene["rows"]:
         assert r["default"] == (r["settings"] == default_settings(r["method"]) or r["method"] == "none")
@@ -181,7 +181,7 @@ def _peer(samples, seconds, err, denoise=False):
 
 
 def test_pareto_front():
-    from bounce_gi.addon.bench_report import pareto
+    from bounce_gi.addon.bench.front import pareto
 
     rows = [_row("none", 0.01, 0.5), _row("lpv", 1.0, 0.3, {"resolution": 16, "bounces": 1}),
             _row("vct", 0.5, 0.2, {"resolution": 64, "bounces": 1})]
@@ -192,7 +192,7 @@ def test_pareto_front():
 
 
 def test_peer_time_at_error_interpolates_log_log():
-    from bounce_gi.addon.bench_report import peer_time_at_error
+    from bounce_gi.addon.bench.front import peer_time_at_error
 
     # an exact power law err = 0.4·t^(-1/2): log-log interpolation must recover it between points
     peers = [_peer(s, t, 0.4 * t ** -0.5) for s, t in ((1, 0.01), (4, 0.04), (16, 0.16))]
@@ -204,7 +204,7 @@ def test_peer_time_at_error_interpolates_log_log():
 
 
 def test_log_log_slope():
-    from bounce_gi.addon.bench_scaling import fit_slope
+    from bounce_gi.addon.bench.scaling import fit_slope
 
     xs = [10, 100, 1000, 10000]
     assert fit_slope(xs, [3 * x ** 0.75 for x in xs]) == pytest.approx(0.75)
@@ -212,7 +212,7 @@ def test_log_log_slope():
 
 
 def test_synthetic_scaling_scene_has_the_stated_triangle_count():
-    from bounce_gi.addon.bench_scaling import synthetic_scene
+    from bounce_gi.addon.bench.scaling import synthetic_scene
 
     assert synthetic_scene(3).triangle_count == 2 + 20 * 4 ** 3
 

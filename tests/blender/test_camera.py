@@ -1,4 +1,4 @@
-"""gpu_kernels.common.camera reproduces Blender's camera exactly (design.md §3: lens/sensor, sensor fit, shift, pixel
+"""gpu_kernels.common.camera reproduces Blender's camera exactly (docs/conventions.md, Camera: lens/sensor, sensor fit, shift, pixel
 aspect, ortho scale, clip).
 
 The reference is Blender itself: `Object.calc_matrix_camera(depsgraph, x, y, scale_x, scale_y)` (the projection

@@ -1,4 +1,4 @@
-"""gpu_kernels.output.exr: multi-part EXR in Blender 5's layout (design.md §3), atomic writes, reading real Blender
+"""gpu_kernels.output.exr: multi-part EXR in Blender 5's layout (docs/conventions.md, Passes), atomic writes, reading real Blender
 output, and the sRGB preview tone map."""
 import math
 import os
@@ -52,7 +52,7 @@ def test_layout_matches_blender_multipart(tmp_path):
     while inp.seek_subimage(sub, 0):
         spec = inp.spec()
         parts.append((spec.getattribute("name"), tuple(spec.channelnames), spec.width, spec.height, str(spec.format)))
-        # Each part's pixels are that pass's (read with the 5-argument form, design.md §3).
+        # Each part's pixels are that pass's (read with the 5-argument form, docs/conventions.md).
         data = np.asarray(inp.read_image(sub, 0, 0, spec.nchannels, oiio.FLOAT)).reshape(3, 4, -1)
         name = spec.getattribute("name").split(".", 1)[1]
         image = passes[name] if passes[name].ndim == 3 else passes[name][..., None]

@@ -1,5 +1,5 @@
 """gpu_kernels.light_buffers: CPU records mirror the GLSL structs (std430, checked by parsing and on the GPU),
-area-light polygons, the shadow atlas packer, and the light units of design.md §3."""
+area-light polygons, the shadow atlas packer, and the light units of docs/conventions.md."""
 import math
 import re
 

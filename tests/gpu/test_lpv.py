@@ -184,7 +184,7 @@ def test_world_light_reaches_an_open_floor_and_not_a_closed_sphere(engine):
 
 @pytest.mark.parametrize("downsample", [2, 4])
 def test_intensity_aware_rsm_downsampling_keeps_the_flux(engine, downsample):
-    """Clustering k×k RSM texels into one VPL (seed 001) sums their flux: the injected total must not change
+    """Clustering k×k RSM texels into one VPL (Kaplanyan 2009, §N.5.2) sums their flux: the injected total must not change
     (float32 sums: 1e-4), and the image may change only by where the merged VPLs sit (means within 10%). The
     setting is the propagating transport's (the gather clusters to its own VPL budget, test_lpv_gather.py)."""
     scene = _sphere_scene()

@@ -1,4 +1,4 @@
-"""Octree LPV (seed 002, gpu_kernels/lpv_octree.py): downsampling, index volume, merge, equivalence, light level.
+"""Octree LPV (Olovsson and Doggett 2013, gpu_kernels/lpv/octree.py): downsampling, index volume, merge, equivalence, light level.
 
 Grids are small (16³/32³): llvmpipe on shared CPUs.
 """
@@ -165,7 +165,7 @@ def test_octree_light_level_against_many_uniform_iterations(engine):
 
 
 def test_octree_error_metric_is_zero_before_propagation_and_grows(engine):
-    """Seed 002 §4.1: right after downsampling every O_i equals Ô_i (the downsampled O_{i-1}), in merge units — so
+    """Olovsson and Doggett 2013, §4.1: right after downsampling every O_i equals Ô_i (the downsampled O_{i-1}), in merge units — so
     e_abs = 0 (float32: 1e-6 of the largest coefficient) — and propagation makes the levels diverge (e_abs > 0)."""
     settings = LpvSettings(resolution=16, octree_levels=3)
     engine.render(_sphere_scene(), RenderSettings("lpv", 32, 24, lpv=settings))

@@ -1,5 +1,5 @@
 """gpu_kernels.pass_cache: skip what did not change, release what is replaced; and the real pipeline re-running
-exactly the passes downstream of a change (design.md §2), with the direct light checked against the analytic value."""
+exactly the passes downstream of a change (docs/architecture.md, The pipeline and its pass cache), with the direct light checked against the analytic value."""
 import math
 import time
 

@@ -1,4 +1,4 @@
-"""Voxel Cone Tracing (seed 004): properties that must hold by construction, with tolerances and their reasons.
+"""Voxel Cone Tracing (Crassin et al. 2011; Freed 2018): properties that must hold by construction, with tolerances and their reasons.
 
 (a) White furnace: a closed box whose walls all emit Le and reflect ρ, no lights. Emissive triangles are lights, so
     Diffuse Direct = Le (irradiance π·Le from the walls all round) and light that bounced k times arrives with

@@ -1,4 +1,4 @@
-"""VCT specular cone (seed 004 §4.5.2) and the passes that come with it: Glossy Indirect, Glossy Color, AO.
+"""VCT specular cone (Freed 2018, §4.5.2) and the passes that come with it: Glossy Indirect, Glossy Color, AO.
 
 Scene: a floor under a wall lit by a horizontal sun (the floor gets no direct light, n·l = 0), so the wall's
 outgoing radiance is exactly L_wall = ρ·S/π and a mirror floor must show it in Glossy Indirect wherever its

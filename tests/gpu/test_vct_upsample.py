@@ -1,4 +1,4 @@
-"""Reduced-resolution VCT gather and its discontinuity-aware upsampling (seed 003, inferred lighting).
+"""Reduced-resolution VCT gather and its discontinuity-aware upsampling (inferred lighting, Kircher and Lawrance 2009).
 
 The upsampler (vct/upsample.glsl) is driven directly with fields we choose, on G-buffers rendered from an orthographic
 camera looking straight down, where world position is affine in the pixel coordinates, so bilinear interpolation of

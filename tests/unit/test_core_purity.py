@@ -1,4 +1,4 @@
-"""gpu_kernels is the pure half (design.md §2): importing it, and every module in it, never pulls in bpy or mathutils.
+"""gpu_kernels is the pure half (docs/architecture.md, One import direction): importing it, and every module in it, never pulls in bpy or mathutils.
 
 The import check runs in a fresh interpreter so that nothing another test imported (bpy included) can hide or
 fake a leak. The source grep catches imports hidden inside functions, which an import-time check cannot see.

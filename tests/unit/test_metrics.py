@@ -1,4 +1,4 @@
-"""gpu_kernels.metrics: rel-L1 and relMSE as design.md §3 defines them, masks, and the heat-map ramp."""
+"""gpu_kernels.output.metrics: rel-L1 and relMSE as docs/conventions.md defines them, masks, and the heat-map ramp."""
 import math
 
 import numpy as np
