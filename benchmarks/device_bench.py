@@ -69,7 +69,7 @@ def _load(scene_dir, name, w, h):
 
 def _timed(engine, scene, settings, repeats):
     """(median seconds, runs) of lpv_bench's warm-up-then-repeat timing."""
-    from benchmarks.lpv_bench import _timed as timed_runs
+    from benchmarks.lpv_bench import timed_runs
 
     runs = timed_runs(engine, scene, settings, repeats)
     return statistics.median(r[0] for r in runs), runs

@@ -68,13 +68,7 @@ def main():
         for cfg in (c for c in CONFIGS if c["transport"] in args.transports):
             settings = RenderSettings("lpv", *args.res, lpv=LpvSettings(
                 **{**cfg, **({"bounces": args.bounces} if args.bounces else {})}))
-            engine.render(scene, settings)  # warm-up: compiles shaders
-            runs = []
-            for _ in range(args.repeats):
-                engine.clear_cache()
-                start = time.perf_counter()
-                result = engine.render(scene, settings)
-                runs.append((time.perf_counter() - start, result))
+            runs = timed_runs(engine, scene, settings, args.repeats)
             total = statistics.median(r[0] for r in runs)
             result = runs[-1][1]
             times = [statistics.median(r[1].timings.get(p, 0.0) for r in runs) * 1000 for p in PASSES]
@@ -89,8 +83,8 @@ def main():
                   "".join(f"{t:>16.1f}" for t in times) + f"{total * 1000:>10.0f}" + errors, flush=True)
 
 
-def _timed(engine, scene, settings, repeats):
-    """Median pass times (ms) and total of `repeats` full re-renders after a warm-up, and the last result."""
+def timed_runs(engine, scene, settings, repeats):
+    """(seconds, result) of `repeats` full re-renders (pass cache cleared) after a warm-up that compiles shaders."""
     engine.render(scene, settings)  # warm-up: compiles shaders
     runs = []
     for _ in range(repeats):
@@ -121,7 +115,7 @@ def octree_table(args, engine, scenes, extract_scene, render_reference, Referenc
         for label, cfg in OCTREE_CONFIGS:
             settings = RenderSettings("lpv", *args.res, lpv=LpvSettings(
                 resolution=32, transport="propagate", **{"bounces": args.bounces or 3, **cfg}))
-            runs = _timed(engine, scene, settings, args.repeats)
+            runs = timed_runs(engine, scene, settings, args.repeats)
             result = runs[-1][1]
             ms = {p: statistics.median(r[1].timings.get(p, 0.0) for r in runs) * 1000 for p in OCTREE_PASSES}
             lpv_ms = sum(ms[p] for p in ("lpv_inject", "lpv_downsample", "lpv_propagate", "lpv_merge", "lpv_lighting"))

@@ -36,7 +36,7 @@ def build_scene(name):
         scenes.build(name)
 
 
-def main():
+def parse_args():
     parser = argparse.ArgumentParser()
     parser.add_argument("--scenes", nargs="+", default=["cornell", "spot_room", "courtyard"])
     parser.add_argument("--grids", nargs="+", type=int, default=[64, 128])
@@ -48,16 +48,71 @@ def main():
     parser.add_argument("--samples", type=int, default=64, help="Cycles samples per seed (0: skip the errors)")
     parser.add_argument("--ref-bounces", type=int, default=8, help="Cycles bounces")
     parser.add_argument("--repeats", type=int, default=2)
-    args = parser.parse_args()
+    return parser.parse_args()
 
-    import bpy
-    import numpy as np
 
-    from bounce_gi.addon.reference.cycles import ReferenceSettings, render_reference
-    from bounce_gi.addon.extract import extract_scene
+def timed_runs(engine, scene, settings, repeats):
+    """(seconds, result) of `repeats` full re-renders (pass cache cleared) after a warm-up that compiles shaders."""
+    engine.render(scene, settings)  # warm-up: compiles shaders
+    runs = []
+    for _ in range(repeats):
+        engine.clear_cache()
+        start = time.perf_counter()
+        result = engine.render(scene, settings)
+        runs.append((time.perf_counter() - start, result))
+    return runs
+
+
+def error_columns(result, ref) -> str:
+    """rel-L1 (and the reference's noise floor) of Diffuse Indirect, Combined and, where glossy, Glossy Indirect."""
     from bounce_gi.gpu_kernels.output import metrics
-    from bounce_gi.gpu_kernels.engine import Engine
+
+    if ref is None:
+        return ""
+    mask = (ref.passes["Depth"][..., 0] < 1e9) & (result.passes["Depth"][..., 0] < 1e9)
+    errors = "".join(f"{metrics.rel_l1(result.passes[p], ref.passes[p], mask):>10.3f}"
+                     f"{ref.noise_floor(p, mask):>8.3f} " for p in ("Diffuse Indirect", "Combined"))
+    glossy = mask & (ref.passes["Glossy Color"].max(axis=-1) > 0) & \
+        (result.passes["Glossy Color"].max(axis=-1) > 0)
+    if glossy.any() and "Glossy Indirect" in ref.passes:
+        errors += (f"{metrics.rel_l1(result.passes['Glossy Indirect'], ref.passes['Glossy Indirect'], glossy):>9.3f}"
+                   f"{ref.noise_floor('Glossy Indirect', glossy):>8.3f}")
+    return errors
+
+
+def scene_rows(args, engine, name, res):
+    """The table's rows of one scene at one image size: every grid and indirect_scale."""
+    import bpy
+
+    from bounce_gi.addon.extract import extract_scene
+    from bounce_gi.addon.reference.cycles import ReferenceSettings, render_reference
     from bounce_gi.gpu_kernels.settings import RenderSettings
+    from bounce_gi.gpu_kernels.vct.settings import VctSettings
+
+    w, h = (int(v) for v in res.lower().split("x"))
+    build_scene(name)
+    scene = extract_scene(bpy.context.evaluated_depsgraph_get(), (w, h))
+    ref = None
+    if args.samples:
+        ref = render_reference(scene.content_hash(), ReferenceSettings(w, h, samples=args.samples,
+                                                                       bounces=args.ref_bounces))
+    for grid in args.grids:
+        for scale in args.scales:
+            vs = VctSettings(resolution=grid, bounces=args.bounces, anisotropic=bool(args.anisotropic),
+                             indirect_scale=scale, specular_cone=bool(args.specular))
+            runs = timed_runs(engine, scene, RenderSettings("vct", w, h, vct=vs), args.repeats)
+            total = statistics.median(r[0] for r in runs)
+            result = runs[-1][1]
+            times = [statistics.median(r[1].timings.get(p, 0.0) for r in runs) * 1000 for p in PASSES]
+            print(f"{name:<15}{grid:>5}³{res:>9}{scale:>3}" + "".join(f"{t:>10.0f}" for t in times) +
+                  f"{total * 1000:>9.0f}{result.info.get('fixup_pixels', 0):>6}" + error_columns(result, ref),
+                  flush=True)
+
+
+def main():
+    args = parse_args()
+
+    from bounce_gi.gpu_kernels.engine import Engine
     from bounce_gi.gpu_kernels.vct.settings import VctSettings
 
     if args.bounces is None:
@@ -73,42 +128,7 @@ def main():
     print(header)
     for name in args.scenes:
         for res in args.res:
-            w, h = (int(v) for v in res.lower().split("x"))
-            build_scene(name)
-            scene = extract_scene(bpy.context.evaluated_depsgraph_get(), (w, h))
-            ref = None
-            if args.samples:
-                ref = render_reference(scene.content_hash(), ReferenceSettings(w, h, samples=args.samples,
-                                                                               bounces=args.ref_bounces))
-            for grid in args.grids:
-                for scale in args.scales:
-                    vs = VctSettings(resolution=grid, bounces=args.bounces, anisotropic=bool(args.anisotropic),
-                                     indirect_scale=scale, specular_cone=bool(args.specular))
-                    settings = RenderSettings("vct", w, h, vct=vs)
-                    engine.render(scene, settings)  # warm-up: compiles shaders
-                    runs = []
-                    for _ in range(args.repeats):
-                        engine.clear_cache()
-                        start = time.perf_counter()
-                        result = engine.render(scene, settings)
-                        runs.append((time.perf_counter() - start, result))
-                    total = statistics.median(r[0] for r in runs)
-                    result = runs[-1][1]
-                    times = [statistics.median(r[1].timings.get(p, 0.0) for r in runs) * 1000 for p in PASSES]
-                    errors = ""
-                    if ref is not None:
-                        mask = (ref.passes["Depth"][..., 0] < 1e9) & (result.passes["Depth"][..., 0] < 1e9)
-                        errors = "".join(f"{metrics.rel_l1(result.passes[p], ref.passes[p], mask):>10.3f}"
-                                         f"{ref.noise_floor(p, mask):>8.3f} " for p in ("Diffuse Indirect",
-                                                                                        "Combined"))
-                        glossy = mask & (ref.passes["Glossy Color"].max(axis=-1) > 0) & \
-                            (result.passes["Glossy Color"].max(axis=-1) > 0)
-                        if glossy.any() and "Glossy Indirect" in ref.passes:
-                            errors += (f"{metrics.rel_l1(result.passes['Glossy Indirect'], ref.passes['Glossy Indirect'], glossy):>9.3f}"
-                                       f"{ref.noise_floor('Glossy Indirect', glossy):>8.3f}")
-                    print(f"{name:<15}{grid:>5}³{res:>9}{scale:>3}" + "".join(f"{t:>10.0f}" for t in times) +
-                          f"{total * 1000:>9.0f}{result.info.get('fixup_pixels', 0):>6}" + errors, flush=True)
-
+            scene_rows(args, engine, name, res)
 
 if __name__ == "__main__":
     main()

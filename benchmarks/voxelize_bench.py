@@ -67,77 +67,93 @@ def trimesh_occupancy(mesh, grid):
     return occ
 
 
-def main():
+def parse_args():
     parser = argparse.ArgumentParser()
     parser.add_argument("meshes", nargs="*")
     parser.add_argument("--res", nargs="+", type=int, default=[64, 128, 256])
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--supersample", type=int, default=2)
     parser.add_argument("--no-iou", action="store_true", help="skip trimesh (slow for big flat faces at 256³)")
-    args = parser.parse_args()
+    return parser.parse_args()
 
-    from bounce_gi.gpu_kernels.direct import geometry as direct
-    from bounce_gi.gpu_kernels.voxel import voxelize as vz
-    from bounce_gi.gpu_kernels.gl.context import create_context
-    from bounce_gi.gpu_kernels.common.grid import Grid
-    from bounce_gi.gpu_kernels.gl.programs import ProgramCache
+
+def to_scene(mesh):
     from bounce_gi.gpu_kernels.scene import Material, Scene
 
-    ctx = create_context()
-    programs = ProgramCache(ctx)
-    print(f"GL: {ctx.info['GL_RENDERER']} ({ctx.version_code}); supersample {args.supersample}; "
-          f"median of {args.repeats} after a warm-up")
+    pos = np.asarray(mesh.triangles, np.float32)
+    t = len(pos)
+    return Scene(pos, np.repeat(np.asarray(mesh.face_normals, np.float32)[:, None], 3, axis=1),
+                 np.zeros((t, 3, 2), np.float32), np.zeros(t, np.int32), [Material("m")])
 
-    def to_scene(mesh):
-        pos = np.asarray(mesh.triangles, np.float32)
-        t = len(pos)
-        return Scene(pos, np.repeat(np.asarray(mesh.face_normals, np.float32)[:, None], 3, axis=1),
-                     np.zeros((t, 3, 2), np.float32), np.zeros(t, np.int32), [Material("m")])
 
-    def timed(scene, geometry, grid, mode):
-        vz.voxelize(ctx, programs, scene, geometry, [], grid, mode=mode, supersample=args.supersample).release()
-        times, volumes = [], None
-        for _ in range(args.repeats):
-            if volumes is not None:
-                volumes.release()
-            ctx.finish()
-            start = time.perf_counter()
-            volumes = vz.voxelize(ctx, programs, scene, geometry, [], grid, mode=mode, supersample=args.supersample)
-            ctx.finish()
-            times.append(time.perf_counter() - start)
-        area = np.frombuffer(volumes.area.read(), np.float32).reshape(*grid.shape_zyx, 4)[..., 3]
-        volumes.release()
-        return statistics.median(times), area
+def timed(gl, scene, geometry, grid, mode, args):
+    """(median seconds of --repeats voxelisations after a warm-up, the area channel of the last one)."""
+    from bounce_gi.gpu_kernels.voxel import voxelize as vz
+
+    ctx, programs = gl
+    vz.voxelize(ctx, programs, scene, geometry, [], grid, mode=mode, supersample=args.supersample).release()
+    times, volumes = [], None
+    for _ in range(args.repeats):
+        if volumes is not None:
+            volumes.release()
+        ctx.finish()
+        start = time.perf_counter()
+        volumes = vz.voxelize(ctx, programs, scene, geometry, [], grid, mode=mode, supersample=args.supersample)
+        ctx.finish()
+        times.append(time.perf_counter() - start)
+    area = np.frombuffer(volumes.area.read(), np.float32).reshape(*grid.shape_zyx, 4)[..., 3]
+    volumes.release()
+    return statistics.median(times), area
+
+
+def fixed_cost_rows(gl, args) -> list:
+    """One "no triangles" row per grid: clearing and resolving the volumes alone."""
+    from bounce_gi.gpu_kernels.common.grid import Grid
+    from bounce_gi.gpu_kernels.direct import geometry as direct
+    from bounce_gi.gpu_kernels.scene import Material, Scene
+    from bounce_gi.gpu_kernels.voxel import voxelize as vz
 
     rows = []
     empty = Scene(np.zeros((0, 3, 3), np.float32), np.zeros((0, 3, 3), np.float32), np.zeros((0, 3, 2), np.float32),
                   np.zeros(0, np.int32), [Material("m")])
-    geometry = direct.upload_geometry(ctx, programs, empty)
+    geometry = direct.upload_geometry(*gl, empty)
     for res in args.res:
         grid = Grid((0.0, 0.0, 0.0), 1.0, (res, res, res))
-        rows.append(("no triangles (fixed cost)", 0, grid.size, *(timed(empty, geometry, grid, m)[0] for m in vz.MODES),
+        rows.append(("no triangles (fixed cost)", 0, grid.size, *(timed(gl, empty, geometry, grid, m, args)[0]
+                                                                 for m in vz.MODES),
                      None, None, None, None))
     geometry.release()
+    return rows
 
-    for name, mesh in meshes(args.meshes).items():
-        scene = to_scene(mesh)
-        geometry = direct.upload_geometry(ctx, programs, scene)
-        for res in args.res:
-            grid = Grid.fit(*scene.bounds(), res)
-            ref = None if args.no_iou else trimesh_occupancy(mesh, grid)
-            row = [name, scene.triangle_count, grid.size]
-            stats = []
-            for mode in vz.MODES:
-                seconds, area = timed(scene, geometry, grid, mode)
-                row.append(seconds)
-                occ = area > 0
-                iou = None if ref is None else np.count_nonzero(occ & ref) / np.count_nonzero(occ | ref)
-                stats += [iou, area.sum(dtype=np.float64) / mesh.area - 1.0]  # (iou, err) per mode
-            rows.append((*row, *stats))
-            print(f"  done {name} {res}³", file=sys.stderr)
-        geometry.release()
 
-    fmt = lambda v, f: "—" if v is None else format(v, f)
+def mesh_rows(gl, name, mesh, args) -> list:
+    """Time, IoU against trimesh and area error of both voxelizers, per grid, for one mesh."""
+    from bounce_gi.gpu_kernels.common.grid import Grid
+    from bounce_gi.gpu_kernels.direct import geometry as direct
+    from bounce_gi.gpu_kernels.voxel import voxelize as vz
+
+    rows = []
+    scene = to_scene(mesh)
+    geometry = direct.upload_geometry(*gl, scene)
+    for res in args.res:
+        grid = Grid.fit(*scene.bounds(), res)
+        ref = None if args.no_iou else trimesh_occupancy(mesh, grid)
+        row = [name, scene.triangle_count, grid.size]
+        stats = []
+        for mode in vz.MODES:
+            seconds, area = timed(gl, scene, geometry, grid, mode, args)
+            row.append(seconds)
+            occ = area > 0
+            iou = None if ref is None else np.count_nonzero(occ & ref) / np.count_nonzero(occ | ref)
+            stats += [iou, area.sum(dtype=np.float64) / mesh.area - 1.0]  # (iou, err) per mode
+        rows.append((*row, *stats))
+        print(f"  done {name} {res}³", file=sys.stderr)
+    geometry.release()
+    return rows
+
+
+def print_table(rows) -> None:
+    fmt = lambda v, f: "—" if v is None else format(v, f)  # noqa: E731
     print(f"\n{'mesh':26s} {'tris':>6s} {'grid':>11s} | {'raster ms':>9s} {'tess ms':>8s} | "
           f"{'IoU r':>6s} {'IoU t':>6s} | {'area err r':>10s} {'area err t':>10s}")
     for name, tris, size, t_r, t_t, iou_r, err_r, iou_t, err_t in rows:
@@ -146,9 +162,25 @@ def main():
               f"{fmt(iou_r, '6.3f')} {fmt(iou_t, '6.3f')} | {fmt(err_r, '10.1e')} {fmt(err_t, '10.1e')}")
     print("\nseed 004 Table 5.2 (GTX 970, ms): " +
           "; ".join(f"{r}³ raster {a:.2f} tess {b:.2f}" for r, (a, b) in SEED_TABLE.items()))
+
+
+def main():
+    args = parse_args()
+
+    from bounce_gi.gpu_kernels.gl.context import create_context
+    from bounce_gi.gpu_kernels.gl.programs import ProgramCache
+
+    ctx = create_context()
+    programs = ProgramCache(ctx)
+    gl = (ctx, programs)
+    print(f"GL: {ctx.info['GL_RENDERER']} ({ctx.version_code}); supersample {args.supersample}; "
+          f"median of {args.repeats} after a warm-up")
+    rows = fixed_cost_rows(gl, args)
+    for name, mesh in meshes(args.meshes).items():
+        rows += mesh_rows(gl, name, mesh, args)
+    print_table(rows)
     programs.release()
     ctx.release()
-
 
 if __name__ == "__main__":
     main()
