@@ -84,6 +84,30 @@ def test_zips_hold_only_their_platform(built_zips):
         assert not leaked, leaked
 
 
+def test_zip_holds_what_the_extension_imports(built_zips):
+    """The zip ships exactly the modules the extension's entry point imports (directly or through others,
+    function-level imports included), its shaders, the quality table, the manifest, the licence and the wheels:
+    no developer tooling, nothing missing."""
+    import zipfile
+
+    sys.path.insert(0, os.path.join(ROOT, "tests"))
+    try:
+        from support import import_graph
+    finally:
+        sys.path.pop(0)
+    used = {str(import_graph.FILES[m].relative_to(import_graph.ROOT)) for m in import_graph.reachable("bounce_gi")}
+    shaders = {os.path.relpath(p, ROOT) for p in glob.glob(os.path.join(ROOT, "gpu_kernels/shaders/*/*.glsl"))}
+    names = set(zipfile.ZipFile(built_zips["bounce_gi-0.1.0-linux_x64.zip"]).namelist())
+    files = {n for n in names if not n.endswith("/")}
+    shipped_py = {n for n in files if n.endswith(".py")}
+    print("imported but not shipped", sorted(used - shipped_py), "shipped but never imported",
+          sorted(shipped_py - used))
+    assert shipped_py == used
+    other = files - shipped_py - shaders - {n for n in files if n.startswith("wheels/") and n.endswith(".whl")}
+    assert shaders <= files and other == {"blender_manifest.toml", "LICENSE", "addon/quality_front.json"}, other
+    assert len(used) > 40  # the entry point's imports were found (a wrong root would find one module)
+
+
 def test_install_enable_disable(built_zips, tmp_path):
     code = """
         import os, sys
