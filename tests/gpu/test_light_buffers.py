@@ -1,4 +1,4 @@
-"""gpu_kernels.light_buffers: CPU records mirror the GLSL structs (std430, checked by parsing and on the GPU),
+"""gpu_kernels.common.lights: CPU records mirror the GLSL structs (std430, checked by parsing and on the GPU),
 area-light polygons, the shadow atlas packer, and the light units of docs/conventions.md."""
 import math
 import re
@@ -8,10 +8,13 @@ import pytest
 
 from bounce_gi.gpu_kernels.common import lights as lb
 from bounce_gi.gpu_kernels.gl import preprocessor as spp
+from bounce_gi.gpu_kernels.lpv.gather import VPL_DTYPE
 from bounce_gi.gpu_kernels.scene import Light, Material, Scene
 
-COMMON = spp.SHADER_DIR / "common/lights.glsl"
-STRUCT_FOR_DTYPE = {"GpuLight": lb.LIGHT_DTYPE, "ShadowView": lb.VIEW_DTYPE}
+# Every buffer record the shaders share with numpy: struct name → (the include that declares it, its dtype).
+STRUCT_FOR_DTYPE = {"GpuLight": ("common/lights.glsl", lb.LIGHT_DTYPE),
+                    "ShadowView": ("common/lights.glsl", lb.VIEW_DTYPE),
+                    "Vpl": ("common/structs.glsl", VPL_DTYPE)}
 # std430 (GLSL 4.30 §7.6.2.2) base alignment and size of the types these structs may use.
 STD430 = {"float": (4, 4), "int": (4, 4), "uint": (4, 4), "vec2": (8, 8), "vec3": (16, 12), "vec4": (16, 16),
           "ivec4": (16, 16), "mat4": (16, 64)}
@@ -64,9 +67,9 @@ def test_parser_and_std430_rules_on_a_known_struct():
 
 @pytest.mark.parametrize("struct", sorted(STRUCT_FOR_DTYPE))
 def test_numpy_dtype_mirrors_glsl_struct(struct):
-    glsl = parse_structs(COMMON.read_text())
-    assert struct in glsl, f"struct {struct} not found in {COMMON.name}"
-    dt = STRUCT_FOR_DTYPE[struct]
+    include, dt = STRUCT_FOR_DTYPE[struct]
+    glsl = parse_structs((spp.SHADER_DIR / include).read_text())
+    assert struct in glsl, f"struct {struct} not found in {include}"
     fields = glsl[struct]
     assert [n for _, n in fields] == list(dt.names), "field names/order differ"
     assert [t for t, _ in fields] == [dtype_glsl_type(dt.fields[n][0]) for n in dt.names], "field types differ"
