@@ -1,7 +1,7 @@
 """`bounce-gi bench --incremental`: what one update costs in a long-lived engine, by kind of edit.
 
 An update is what the add-on does after an edit: extract the evaluated scene, then `Engine.render`, whose pass cache
-re-runs only the passes whose inputs changed (gpu_kernels/pass_cache.py). Each kind of edit is applied to the open
+re-runs only the passes whose inputs changed (gpu_kernels/gl/pass_cache.py). Each kind of edit is applied to the open
 .blend with bpy (alternately +d and −d, so the scene stays put), and the median of `repeats` updates is reported.
 The file is never saved.
 """
@@ -10,6 +10,8 @@ from __future__ import annotations
 import statistics
 import time
 
+from ..scene_io import load_scene
+
 KINDS = ("full", "unchanged", "camera_only", "light_move", "material_change", "object_move")
 STEP = 0.05  # metres (or colour units) per edit: small enough to stay a "typical" interactive nudge
 
@@ -17,7 +19,7 @@ STEP = 0.05  # metres (or colour units) per edit: small enough to stay a "typica
 def _update(engine, settings, resolution):
     import bpy
 
-    from .extract import extract_scene
+    from ..extract import extract_scene
 
     start = time.perf_counter()
     scene = extract_scene(bpy.context.evaluated_depsgraph_get(), resolution)
@@ -77,8 +79,8 @@ def measure_incremental(scene_resolution, method: str, repeats: int = 3) -> dict
     """Seconds per update kind (median), plus extraction seconds and the passes that re-ran, for one method."""
     import bpy
 
-    from ..gpu_kernels.engine import get_engine
-    from ..gpu_kernels.settings import RenderSettings
+    from ...gpu_kernels.engine import get_engine
+    from ...gpu_kernels.settings import RenderSettings
 
     engine = get_engine()
     w, h = scene_resolution
@@ -116,8 +118,6 @@ def measure_incremental(scene_resolution, method: str, repeats: int = 3) -> dict
 
 
 def run_incremental(path: str, res, methods, progress, repeats: int = 3) -> dict:
-    from .cli import load_scene
-
     scene = load_scene(path, tuple(res) if res else None)
     result = {"scene": path, "resolution": list(scene.resolution), "methods": {}}
     for method in methods:

@@ -1,25 +1,23 @@
-"""The peers `bounce-gi bench` measures on the same scene and resolution: Cycles at 1…256 samples (1…16 with --quick) without and with
-OpenImageDenoise, and EEVEE at its defaults (its first render compiles shaders, so the second is timed).
+"""The peers `bounce-gi bench` measures on the same scene and resolution: Cycles at 1…256 samples (1…16 with
+--quick) without and with OpenImageDenoise, and EEVEE at its defaults (its first render compiles shaders, so the
+second is timed).
 
 Peer times are bpy.ops.render.render wall time: scene sync, render and writing the EXR, as a user would wait.
 Settings are changed inside `saved_attributes`, so the open scene is left as it was.
 """
 from __future__ import annotations
 
-import math
 import os
 import time
+
+from .scores import finite
 
 EEVEE_QUICK_NOTE = ("skipped in --quick: EEVEE takes more than 60 s here (shader compilation + render on a "
                     "software GL; measured 22 s first and 68 s second render at 48x36); run without --quick")
 
 
-def _finite(x):
-    return float(x) if x is not None and math.isfinite(float(x)) else None
-
-
-def _render_exr(bpy, path: str) -> tuple:
-    from ..gpu_kernels.output import exr as exr_io
+def render_exr(bpy, path: str) -> tuple:
+    from ...gpu_kernels.output import exr as exr_io
 
     bpy.context.scene.render.filepath = path
     start = time.perf_counter()
@@ -32,20 +30,20 @@ def render_peers(ref, mask, width, height, quick, progress, tmp, eevee=True) -> 
     """Cycles at a few sample counts without and with OIDN, then EEVEE; (peers, warnings)."""
     import bpy
 
-    from ..gpu_kernels.output import metrics
-    from .reference.cycles import ReferenceSettings, configure_cycles, saved_attributes, settings_to_save
+    from ...gpu_kernels.output import metrics
+    from ..reference.cycles import ReferenceSettings, configure_cycles, saved_attributes, settings_to_save
 
     scene, view_layer = bpy.context.scene, bpy.context.view_layer
     peers, warnings = [], []
 
     def score(passes):
-        return _finite(metrics.rel_l1(passes["Combined"], ref.passes["Combined"], mask))
+        return finite(metrics.rel_l1(passes["Combined"], ref.passes["Combined"], mask))
 
     with saved_attributes(settings_to_save(scene, view_layer) + [(scene.cycles, "denoiser")]):
         path = os.path.join(tmp, "peer.exr")
         configure_cycles(scene, view_layer, ReferenceSettings(width, height, samples=1), 3, path)
         try:
-            _render_exr(bpy, path)  # warm-up: kernel load, first scene sync
+            render_exr(bpy, path)  # warm-up: kernel load, first scene sync
         except Exception as exc:  # noqa: BLE001 — a peer failing must not end the benchmark
             warnings.append(f"Cycles warm-up failed: {exc}")
         for denoise in (False, True):
@@ -59,7 +57,7 @@ def render_peers(ref, mask, width, height, quick, progress, tmp, eevee=True) -> 
                     scene.cycles.use_denoising = denoise
                     if denoise:
                         scene.cycles.denoiser = "OPENIMAGEDENOISE"
-                    entry["seconds"], passes = _render_exr(bpy, path)
+                    entry["seconds"], passes = render_exr(bpy, path)
                     entry["rel_l1"]["combined"] = score(passes)
                 except Exception as exc:  # noqa: BLE001
                     entry["error"] = f"{type(exc).__name__}: {exc}"
@@ -69,7 +67,7 @@ def render_peers(ref, mask, width, height, quick, progress, tmp, eevee=True) -> 
 
 
 def render_eevee(bpy, width, height, skip, progress, tmp, score, warnings) -> dict:
-    from .reference.cycles import saved_attributes
+    from ..reference.cycles import saved_attributes
 
     scene = bpy.context.scene
     r = scene.render
@@ -99,9 +97,9 @@ def render_eevee(bpy, width, height, skip, progress, tmp, score, warnings) -> di
         path = os.path.join(tmp, "eevee.exr")
         try:
             progress("bench: EEVEE first render (compiles shaders)")
-            entry["first_render_seconds"], _ = _render_exr(bpy, path)
+            entry["first_render_seconds"], _ = render_exr(bpy, path)
             progress("bench: EEVEE second render (timed)")
-            entry["seconds"], passes = _render_exr(bpy, path)
+            entry["seconds"], passes = render_exr(bpy, path)
             entry["rel_l1"]["combined"] = score(passes)
         except Exception as exc:  # noqa: BLE001
             entry["error"] = f"{type(exc).__name__}: {exc}"

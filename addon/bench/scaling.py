@@ -19,8 +19,8 @@ def synthetic_scene(subdivisions: int, resolution=(320, 240)):
     """Floor (4 m square) + icosphere (radius 1 m, 20·4^subdivisions triangles) under a tilted sun."""
     import trimesh
 
-    from ..gpu_kernels.common import camera as cam
-    from ..gpu_kernels.scene import Camera, Light, Material, Scene, World
+    from ...gpu_kernels.common import camera as cam
+    from ...gpu_kernels.scene import Camera, Light, Material, Scene, World
 
     sphere = trimesh.creation.icosphere(subdivisions=subdivisions, radius=1.0)
     sphere_pos = (sphere.vertices[sphere.faces] + (0, 0, 1.0)).astype(np.float32)
@@ -79,10 +79,10 @@ def _series(name, xs, measure, progress) -> dict:
 
 
 def run_scaling(quick: bool, progress, methods=("none", "lpv", "vct")) -> dict:
-    from ..gpu_kernels.engine import get_engine
-    from ..gpu_kernels.lpv.settings import LpvSettings
-    from ..gpu_kernels.settings import RenderSettings
-    from ..gpu_kernels.vct.settings import VctSettings
+    from ...gpu_kernels.engine import get_engine
+    from ...gpu_kernels.lpv.settings import LpvSettings
+    from ...gpu_kernels.settings import RenderSettings
+    from ...gpu_kernels.vct.settings import VctSettings
 
     engine = get_engine()
     repeats = 1 if quick else 3
