@@ -132,11 +132,11 @@ def run(engine, scene_dir, grids, lpv_grids, repeats, say):
 
 
 def _edited(scene, kind, sign):
-    """A copy of `scene` after one small edit (bench_incremental.py's kinds, applied to the extracted scene)."""
+    """A copy of `scene` after one small edit (addon/bench/incremental.py's kinds, applied to the extracted scene)."""
     import copy
 
     out = copy.deepcopy(scene)
-    step = sign * 0.05  # metres, as bench_incremental.STEP
+    step = sign * 0.05  # metres, as addon/bench/incremental.STEP
     if kind == "camera_only":
         out.camera.matrix_world[0, 3] += step
     elif kind == "light_move":
