@@ -117,7 +117,7 @@ def run(engine, scene_dir, grids, lpv_grids, repeats, say):
                 iters = sum(c["iterations"] for c in runs[-1][1].info["cascades"])
                 say(f"{name:<11}{grid:>5}³{cascades:>5}{iters:>7}" + "".join(f"{t:>16.1f}" for t in times) +
                     f"{total * 1000:>9.1f}" + _errors(runs[-1][1], ref))
-    say("\nOctree LPV (seed 002 Table 1) against the uniform grid, 32³, 3 bounces")
+    say("\nOctree LPV (Olovsson and Doggett 2013, Table 1) against the uniform grid, 32³, 3 bounces")
     say(f"{'scene':<11}{'config':<18}{'propagate':>11}{'LPV total':>11}{'frame':>9}{'DI relL1':>11}{'Comb relL1':>11}")
     for name in SCENES:
         w, h = ERROR_RES

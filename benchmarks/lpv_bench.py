@@ -4,9 +4,9 @@ Prints a table (median of --repeats full re-renders after a warm-up); asserts no
     .venv/bin/python benchmarks/lpv_bench.py [--scenes cornell spot_room courtyard] [--res 160 120] [--samples 64]
                                              [--transports gather propagate]
 
---octree: seed 002's Table 1 instead — per-step ms (inject, downsample, propagate, merge, lighting) and iteration
+--octree: Olovsson and Doggett 2013's Table 1 instead — per-step ms (inject, downsample, propagate, merge, lighting) and iteration
 counts of the octree LPV (k = 4 per level) against the uniform grid (k = 16 and the adaptive default), at 32³, with
-the errors against Cycles, then the seed's e_abs / e_rel (§4.1) after each octree iteration.
+the errors against Cycles, then the paper's e_abs / e_rel (§4.1) after each octree iteration.
 """
 import argparse
 import os
@@ -37,7 +37,7 @@ def main():
     parser.add_argument("--bounces", type=int, default=None, help="override every configuration's bounce count")
     parser.add_argument("--repeats", type=int, default=2)
     parser.add_argument("--transports", nargs="+", default=["gather", "propagate"], choices=["gather", "propagate"])
-    parser.add_argument("--octree", action="store_true", help="seed 002 Table 1: octree vs uniform at 32³")
+    parser.add_argument("--octree", action="store_true", help="Olovsson and Doggett 2013, Table 1: octree vs uniform at 32³")
     args = parser.parse_args()
 
     import bpy
@@ -138,7 +138,7 @@ def octree_table(args, engine, scenes, extract_scene, render_reference, Referenc
 
 
 def octree_errors(engine, settings, lpv_octree) -> str:
-    """Seed 002 §4.1 after each iteration: re-run the propagation of the cached octree one step at a time."""
+    """Olovsson and Doggett 2013, §4.1, after each iteration: re-run the propagation of the cached octree one step at a time."""
     def run(ctx):
         cache = engine.pipeline.cache
         tree, geo = cache.entries["lpv_downsample"].value, cache.entries["lpv_octree_geometry"].value

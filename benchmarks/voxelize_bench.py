@@ -1,4 +1,4 @@
-"""Voxelisation time and coverage, laid out like seed 004 Table 5.2 (rasterised vs tessellated, 64³–256³).
+"""Voxelisation time and coverage, laid out like Freed 2018, Table 5.2 (rasterised vs tessellated, 64³–256³).
 
 For each mesh and grid: median of --repeats timed runs after one warm-up (ctx.finish() inside the timing: the
 whole pass — clear, draw, resolve into four RGBA32F volumes), the surface-voxel IoU against trimesh's
@@ -18,7 +18,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
-# Seed 004 Table 5.2 (GTX 970, the thesis' Sponza-like scene; rasterised with MSAA conservative rasterisation).
+# Freed 2018, Table 5.2 (GTX 970, the thesis' Sponza-like scene; rasterised with MSAA conservative rasterisation).
 SEED_TABLE = {64: (0.53, 0.70), 128: (0.85, 1.12), 256: (1.91, 2.35)}
 
 
@@ -160,7 +160,7 @@ def print_table(rows) -> None:
         grid = "×".join(map(str, size))
         print(f"{name:26s} {tris:6d} {grid:>11s} | {t_r * 1000:9.1f} {t_t * 1000:8.1f} | "
               f"{fmt(iou_r, '6.3f')} {fmt(iou_t, '6.3f')} | {fmt(err_r, '10.1e')} {fmt(err_t, '10.1e')}")
-    print("\nseed 004 Table 5.2 (GTX 970, ms): " +
+    print("\nFreed 2018, Table 5.2 (GTX 970, ms): " +
           "; ".join(f"{r}³ raster {a:.2f} tess {b:.2f}" for r, (a, b) in SEED_TABLE.items()))
 
 

@@ -4,7 +4,7 @@ and EEVEE peers rendered in the same run at the same resolution (peers.py); Pare
 
 Rows (ours, sweep.py): a warm-up render (shader compilation, uploads), then the median of N full frames, each with
 every pass cache cleared, plus the scene extraction time (an update in Blender extracts too, and the Cycles peers'
-times include their scene sync) (timing.py). Errors over pixels that hit geometry (design.md §3): rel-L1 of
+times include their scene sync) (timing.py). Errors over pixels that hit geometry (docs/conventions.md, Error metrics): rel-L1 of
 Combined and Diffuse Indirect, relMSE of Combined, FLIP of Combined (tone-mapped sRGB; in a subprocess because
 flip-evaluator calls sys.exit on bad input) (scores.py). A row that fails records "error" instead of ending the run.
 """

@@ -13,7 +13,7 @@ from support.import_graph import FILES, GRAPH, MODULES, PACKAGE, PRIVATE, ROOT, 
 # lpv | vct → settings, compose → pipeline → engine (scene and output are plain data and I/O, rank 0).
 CORE_RANK = {"gl": 0, "scene": 0, "output": 0, "common": 1, "direct": 2, "voxel": 3, "lpv": 4, "vct": 4,
              "settings": 5, "compose": 5, "pipeline": 6, "engine": 7}
-TOOLING = ("bounce_gi.addon.cli", "bounce_gi.addon.bench")  # developer tooling, left out of the extension zip
+TOOLING = ("bounce_gi.addon.cli", "bounce_gi.addon.bench", "bounce_gi.addon.scene_io")  # left out of the zip
 MAX_MODULE_LINES = 400
 MAX_FUNCTION_LINES = 60
 
