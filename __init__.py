@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Bounce GI: real-time global illumination preview for Blender.
 
 This file is both the Blender extension entry point and the root of the `bounce_gi` Python

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Automatic quality: pick method and settings for a time budget and/or an error target from the measured table
 `quality_front.json` that `bounce-gi bench` writes (committed next to this file; regenerate with `make bench`).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Input and output checks shared by the developer tools (`bounce-gi` in addon/cli/, its benchmark in addon/bench/):
 open a .blend and extract its Scene, check output paths before anything renders, write files, and the one error
 type they raise for bad input.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Timings on a machine without Blender (a GPU box): the VCT and LPV pass tables of vct_bench.py / lpv_bench.py,
 from scenes exported here, errors against the Cycles references exported with them.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """LPV time per pass and error against Cycles for example scenes, over grid size, cascades and bounces.
 Prints a table (median of --repeats full re-renders after a warm-up); asserts nothing.
 

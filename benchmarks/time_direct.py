@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Time Bounce GI's direct-light render of example scenes: cold (first render: shader compile included), warm full
 (every pass re-run, programs compiled) and unchanged (all passes skipped). Prints a table; asserts nothing.
 

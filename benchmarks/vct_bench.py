@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """VCT time per pass and error against Cycles for example scenes, over grid size, image size and indirect_scale.
 Prints a table (median of --repeats full re-renders after a warm-up render that compiles the shaders); asserts
 nothing. Errors are rel-L1 over pixels that hit geometry, against the mean of two Cycles seeds (64 spp, 8 bounces

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Voxelisation time and coverage, laid out like Freed 2018, Table 5.2 (rasterised vs tessellated, 64³–256³).
 
 For each mesh and grid: median of --repeats timed runs after one warm-up (ctx.finish() inside the timing: the

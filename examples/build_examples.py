@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Write the example scenes as .blend files.
 
     python examples/build_examples.py OUTDIR [name ...]

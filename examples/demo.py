@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """`make demo`: build the Cornell box example, render it with Bounce GI, compare with Cycles, print a table.
 
 Writes into --out (default out/demo): cornell.blend; per method, cornell_<method>.exr (Cycles-named passes), PNG

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """compose: the GPU results read back and combined into Cycles-named passes (numpy), every method alike."""
 from __future__ import annotations
 

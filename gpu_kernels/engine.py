@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The process-wide render engine: one GPU worker thread, one pipeline (so caches survive between renders)."""
 from __future__ import annotations
 

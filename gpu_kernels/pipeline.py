@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The render pipeline: a scene and settings in, Cycles-named passes (numpy) and per-pass seconds out.
 
 Passes and their inputs (a pass re-runs only when one of its inputs changed — see gl/pass_cache.py):

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The GPU side's only input: a scene as plain dataclasses and numpy arrays.
 
 Everything here is in Blender's world space (metres, Z up) and Blender's units (docs/conventions.md).

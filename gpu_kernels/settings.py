@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """What a render is asked for: the method, the resolution and each stage's settings; and the checks that turn bad
 input into one clear message (SceneError) before any GPU work starts."""
 from __future__ import annotations

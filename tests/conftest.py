@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Shared fixtures: one Cycles reference cache per test session, and the example-scene comparison runner."""
 import json
 import os

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Build the Bounce GI extension zips: fetch the bundled wheels, validate, build per platform.
 
     python tools/package.py               # wheels -> validate -> dist/bounce_gi-<ver>-<platform>.zip

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Blender UI of Bounce GI: settings on the Scene, a 3D-view sidebar panel, the preview operator.
 
 Imported only from the extension's register() (it imports bpy). Modules register in the order

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The Render Preview operator: extract on the main thread, render on the engine's thread.
 
 Interactively (invoke) it is modal: a window-manager timer polls the engine's Future, so the UI

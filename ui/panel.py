@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Sidebar panels in the 3D View (N panel, tab "Bounce GI"): settings, render button, last result.
 
 Panels only read state; everything they show about the last render comes from

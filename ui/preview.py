@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The steps of a preview render as plain functions, and the runtime state of the last one.
 
 The operator (operators.py) only schedules these steps: start_render() extracts the scene and

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Per-scene settings, stored in the .blend as `bpy.types.Scene.bounce_gi`.
 
 Only user choices live here. Results of the last render are runtime state (see preview.py)

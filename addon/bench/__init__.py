@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """`bounce-gi bench`: time and error of our methods against Cycles (± OIDN) and EEVEE, in the order a run goes:
 
 - sweep.py: the settings each method is benched at, and how rows are named;

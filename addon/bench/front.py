@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """What a benchmarked scene's rows and peers mean together: the Pareto front in (seconds, Combined rel-L1) and the
 speed-up of each of our rows over Cycles (± OIDN) at equal error. Pure functions of the JSON report."""
 from __future__ import annotations

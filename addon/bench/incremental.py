@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """`bounce-gi bench --incremental`: what one update costs in a long-lived engine, by kind of edit.
 
 An update is what the add-on does after an edit: extract the evaluated scene, then `Engine.render`, whose pass cache

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The peers `bounce-gi bench` measures on the same scene and resolution: Cycles at 1…256 samples (1…16 with
 --quick) without and with OpenImageDenoise, and EEVEE at its defaults (its first render compiles shaders, so the
 second is timed).

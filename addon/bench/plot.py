@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The benchmark's plot of one scene: log-log seconds per frame against Combined rel-L1, our rows by method, the
 Pareto front of our rows, the Cycles ± OIDN sample curves and EEVEE (a PNG of 860x520 pixels).
 

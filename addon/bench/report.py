@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """What `bounce-gi bench` writes besides the plots (plot.py): summary.md, the plain-text output, and the quality
 table automatic quality (addon/quality.py) chooses from.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """`bounce-gi bench`: time and error of our methods against a two-seed Cycles reference, beside Cycles (± OIDN)
 and EEVEE peers rendered in the same run at the same resolution (peers.py); Pareto front, speed-ups at equal error
 (front.py), log-log plot (plot.py) and summary.md (report.py); the table automatic quality picks from (quality.py).

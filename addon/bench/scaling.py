@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """`bounce-gi bench --scaling`: frame time against triangle count, grid size and image resolution, with the
 fitted log-log slope of each (time ∝ xᵇ: b ≈ 1 is linear; b ≈ 0 means that size does not drive the cost).
 

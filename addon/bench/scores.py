@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The errors of one render against the two-seed Cycles reference, over pixels that hit geometry: rel-L1 and
 relMSE (gpu_kernels/output/metrics.py) and FLIP of tone-mapped sRGB (flip-evaluator, in a subprocess)."""
 from __future__ import annotations

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The rows a benchmark measures: each method's settings from its cheap corner to its most accurate, and the
 labels the summary, the Pareto front and the quality table name rows and peers by."""
 from __future__ import annotations

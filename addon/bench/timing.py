@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Frame times as the benchmark measures them: a warm-up render (shader compilation, uploads), then the median of
 N full frames, each with every pass cache cleared, plus the scene extraction time; and the machine they ran on."""
 from __future__ import annotations

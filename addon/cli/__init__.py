@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """`bounce-gi`: render a .blend with Bounce GI, or compare it with a Cycles reference, from the command line.
 
 Runs Blender as a Python module (bpy), so it works in background batch jobs. Bad input gives one line on stderr

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """`python -m bounce_gi.addon.cli`: the `bounce-gi` console script without the installed entry point."""
 import sys
 

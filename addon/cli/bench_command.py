@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """`bounce-gi bench`: the benchmark (addon/bench/) from the command line; time and error of our settings vs Cycles
 (± OIDN) and EEVEE, or `--incremental` (cost of one update per kind of edit), or `--scaling`."""
 from __future__ import annotations

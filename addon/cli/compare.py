@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """`bounce-gi compare`: render with Bounce GI and against a (cached) two-seed Cycles reference; the errors per pass
 beside the reference's own noise floor, and optionally a heat map of the relative error."""
 from __future__ import annotations

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Method settings from the command line (`--lpv key=value ...`, `--vct ...`), automatic quality
 (`--budget-ms`, `--target-error`), and the one render call `render` and `compare` share."""
 from __future__ import annotations

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """`bounce-gi render`: one .blend rendered from its scene camera into a multi-layer EXR, with per-pass timings."""
 from __future__ import annotations
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Blender → `gpu_kernels.scene.Scene`: the only place that reads scene data through bpy.
 
 One module per thing extracted, each turning bpy data into the core's dataclasses:

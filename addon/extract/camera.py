@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The scene camera and the render size: `gpu_kernels.scene.Camera` from the active camera object."""
 from __future__ import annotations
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The one error extraction raises on purpose (its own module so every extractor can raise it)."""
 
 

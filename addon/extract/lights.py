@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Light objects → `gpu_kernels.scene.Light`, with Cycles' power conventions (exposure, temperature, node
 strength, unnormalised emitters)."""
 from __future__ import annotations

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Materials: Blender node materials reduced to what the pipeline understands (gpu_kernels.scene.Material), and
 the image textures they use (gpu_kernels.scene.Texture).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Geometry: evaluated meshes of the visible object instances → world-space triangle arrays.
 
 Meshes come from the evaluated depsgraph (modifiers applied, collection and geometry-node instances included via

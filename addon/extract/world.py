@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The world: a constant radiance (`gpu_kernels.scene.World`) read from the Background node or viewport colour."""
 from __future__ import annotations
 

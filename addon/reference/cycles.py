@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Cycles ground truth: two-seed reference renders with the settings of docs/conventions.md (Cycles references), cached by content hash.
 
 Settings: CPU, adaptive sampling off, denoising off, clamps 0, light threshold 0, pixel filter 0.01 px (so Cycles

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Example scenes for Bounce GI, built in code with bpy.
 
 Used by the demo, the tests (comparisons against Cycles) and benchmarks.

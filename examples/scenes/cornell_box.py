@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The Cornell box: lit by a square area light (`cornell`) or by an emissive ceiling panel (`cornell_emissive`)."""
 
 import math

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The extraction scene: what the evaluated depsgraph adds over plain meshes (modifiers, collection instances,
 custom split normals)."""
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Building blocks of the example scenes: materials, meshes, camera, lights and world, made with bpy.
 
 Every builder links what it makes into the current scene's collection.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Closed rooms where most light arrives by bounces: a spot-lit room and a courtyard lit through a roof opening."""
 
 import math

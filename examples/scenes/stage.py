@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The stage: floor, back wall, a cube and a sphere, lit by each kind of light in turn; with a checker texture,
 Principled BSDF materials, and shifted and orthographic cameras."""
 

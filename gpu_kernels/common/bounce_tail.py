@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The bounce tail both GI methods share: bounces K+1 … N estimated without gathering them.
 
 The light added by successive bounces of a Jacobi (power) iteration tends to a fixed shape that shrinks by a fixed

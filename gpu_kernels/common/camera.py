@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Blender's camera, reproduced exactly: view matrix, view plane and the OpenGL projection.
 
 The view plane follows Blender's `BKE_camera_params_compute_viewplane` (source/blender/blenkernel/intern/camera.cc),

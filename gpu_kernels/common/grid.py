@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """A regular voxel lattice in world space: cubic cells, origin snapped to whole cells (Freed 2018, §4.1).
 
 Freed 2018, §4.1: "to prevent some issues with temporal artifacts, the voxel textures are snapped to a discrete

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Lights → GPU records, and the shadow views every light needs (pure numpy; no GL here).
 
 Units follow Cycles (docs/conventions.md; intern/cycles/scene/light.cpp):

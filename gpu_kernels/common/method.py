@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """What a GI method's passes hand back to the pipeline (pipeline.METHOD_PASSES)."""
 from __future__ import annotations
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The G-buffer: the scene rasterised from its camera into position, normal, albedo, emission, geometric normal
 and glossy colour targets (direct/gbuffer.glsl)."""
 from __future__ import annotations

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Geometry and material inputs of every raster pass: the interleaved vertex buffer grouped by material, the
 material textures, and drawing one material range at a time with its uniforms (common/materials.glsl)."""
 from __future__ import annotations

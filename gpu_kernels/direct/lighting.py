@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Diffuse Direct: every G-buffer pixel lit by every light, shadowed (direct/light.glsl)."""
 from __future__ import annotations
 

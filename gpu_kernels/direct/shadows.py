@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Shadow maps of every light in one depth atlas, with the light, view and polygon records the shaders read
 (common/lights.py builds them; direct/eval.glsl reads them)."""
 from __future__ import annotations

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """One helper per way a pass hands data to a shader: uniforms, samplers, images, dispatch, the grid, the lights,
 and the texture allocations and read-backs every stage shares. Stages call these rather than moderngl directly,
 so a uniform or a binding is spelled one way everywhere."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The one moderngl context, owned by one dedicated worker thread.
 
 Why a thread: a moderngl context created on Blender's main thread silently breaks Blender's own drawing

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """A tiny pass graph: each pass names its inputs, is timed, and is skipped while its inputs are unchanged.
 
 A pass's key is built from the content hashes of the scene parts it reads (geometry, materials, lights, camera,

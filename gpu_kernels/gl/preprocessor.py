@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """GLSL preprocessing for gpu_kernels: ``#include``, ``#pragma once``, stage and variant defines.
 
 Modelled on moderngl-window's program loader (one ``.glsl`` file holds several stages, each in an

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Compile `.glsl` files into moderngl programs, once per (file, defines), with errors mapped to file:line."""
 from __future__ import annotations
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Light Propagation Volumes (Kaplanyan and Dachsbacher 2010; Kaplanyan 2009; Elvek 2012; Olovsson and Doggett
 2013): RSMs → VPL injection → propagation with fuzzy occlusion →
 absorbed light → irradiance. Every scale is derived, none tuned (see the shaders' comments):

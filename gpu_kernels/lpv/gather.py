@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The LPV's gathered transport (LpvSettings.transport = "gather", the default): light goes straight from lists of
 VPLs to the surface voxels of the geometry volume, with fuzzy visibility through it (lpv/gather.glsl), instead of
 through the Kaplanyan–Dachsbacher propagation. The VPLs are instant radiosity's (Keller 1997); lpv/gather.glsl walks the

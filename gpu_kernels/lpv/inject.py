@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """LPV injection: RSM texels as VPLs and world light at the grid's open border, summed in fixed point into each
 cascade's SH volumes (Kaplanyan and Dachsbacher 2010: light injection)."""
 from __future__ import annotations

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The lpv_lighting pass: Diffuse Indirect per G-buffer pixel from the cascades — the surface voxels' absorbed
 irradiance (the flux lookup) or the SH intensity convolved with the cosine (Kaplanyan's lookup)."""
 from __future__ import annotations

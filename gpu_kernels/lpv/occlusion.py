@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """LPV fuzzy occlusion and the light it stops (Elvek 2012, §3.4): the geometry volume, built from a voxelisation of
 the whole scene, blocks light at cell faces; the flux it blocks is the light the surfaces there absorb, which
 gives their irradiance (lpv/absorb.glsl) and, times albedo, the next bounce's VPLs (lpv/bounce.glsl).

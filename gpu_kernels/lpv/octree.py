@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Octree Light Propagation Volumes (Olovsson and Doggett 2013), an option of the LPV (`octree_levels`).
 
 §3.1 A full octree: every level O_i (i = 0..l-1) is a uniform grid of its own (three RGBA32F 3D textures), O_0 the

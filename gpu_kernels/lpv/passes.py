@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The LPV's passes in the pipeline's pass cache (pipeline.METHOD_PASSES["lpv"]):
 
     rsm              ← shadow views, RSM resolution

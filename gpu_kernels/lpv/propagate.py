@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The classic LPV transport (LpvSettings.transport = "propagate"): the Kaplanyan–Dachsbacher face scheme with
 fuzzy occlusion, bounce by bounce, until a step moves less than ε of the injected flux. World light propagates
 this way under either transport."""

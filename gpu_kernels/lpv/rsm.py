@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Reflective shadow maps (Dachsbacher and Stamminger 2005, "Reflective Shadow Maps"): every shadow view of every
 light rendered once more as position, normal and albedo, the texels the VPLs are made from."""
 from __future__ import annotations

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """LpvSettings: every knob of the Light Propagation Volumes, validated."""
 from __future__ import annotations
 

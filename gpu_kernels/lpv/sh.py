@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Two-band spherical harmonics and the Kaplanyan–Dachsbacher face scheme as linear maps (Kaplanyan and
 Dachsbacher 2010, "Cascaded Light Propagation Volumes for Real-Time Indirect Illumination": propagation)."""
 from __future__ import annotations

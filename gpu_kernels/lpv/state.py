@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The GPU state of one LPV cascade: the cascades' grids, SH volumes, the fixed-point injection accumulator and
 its resolve into float volumes."""
 from __future__ import annotations

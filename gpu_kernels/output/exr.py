@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Multi-part EXR in Blender 5's layout (one part per pass, channels `ViewLayer.<Pass>.<C>`), and PNG previews.
 
 Reading uses `read_image(subimage, miplevel, chbegin, chend, FLOAT)`: the 3-argument form silently returns the

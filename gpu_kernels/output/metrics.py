@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Error metrics against a reference (defined in docs/conventions.md), over pixels that hit geometry."""
 from __future__ import annotations
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Voxel Cone Tracing (Crassin et al. 2011; Freed 2018): voxelize → inject direct light → mipmap → bounce → trace.
 
 Passes (vct/passes.py runs them through the pass cache):

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """vct_bounce: bounces − 1 gathers at the voxel faces, each followed by a re-mip, and the rest of the bounces
 extrapolated as a geometric series (common/bounce_tail.py)."""
 from __future__ import annotations

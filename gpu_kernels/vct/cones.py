@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The diffuse cone set: equal-solid-angle regions of the hemisphere (a cap and one or two rings), each cone's
 axis, weight and aperture, and where the sub-rays of a cone go (Crassin et al. 2011, "Interactive Indirect
 Illumination Using Voxel Cone Tracing", uses five cones; these tables generalise it to 5..31)."""

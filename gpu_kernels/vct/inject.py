@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """vct_inject: the direct light reflected through every voxel face. Surface points are rasterised along their
 dominant axis and lit exactly as the Diffuse Direct pass lights pixels (direct/eval.glsl), then averaged per face
 (Crassin et al. 2011 inject direct light from shadow maps into the voxels; here each voxel face is lit itself)."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """vct_mipmap: the filtered cone volumes built from the face radiances, level by level (isotropic: the mean of
 the children; anisotropic: six directions composited front to back, Crassin et al. 2011's anisotropic voxels),
 and the layer volume that says where each texel's surfaces lie along each axis."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The VCT's passes in the pipeline's pass cache (pipeline.METHOD_PASSES["vct"]):
 
     vct_voxelize    ← geometry, materials, grid

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """VctSettings: every knob of the voxel cone tracer, validated, and the subsets each pass's cache key reads."""
 from __future__ import annotations
 

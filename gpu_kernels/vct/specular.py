@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """VCT specular cone (Freed 2018, §4.5.2: five diffuse cones and one specular cone): one glossy cone per G-buffer pixel
 along the reflected view direction → the Glossy Indirect pass (vct/specular.glsl).
 

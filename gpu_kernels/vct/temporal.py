@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Temporal accumulation of the VCT diffuse gather, for interactive updates (Freed 2018, §4.7.2, blends voxel radiance
 over frames against flicker; here the pixels' gathers are averaged instead, with a hard reset rather than a blend).
 

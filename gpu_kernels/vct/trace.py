@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """vct_trace: the diffuse cones per G-buffer pixel (or per indirect_scale² block) → Diffuse Indirect and voxel
 AO (Crassin et al. 2011, cone tracing of the filtered volumes), the fix-up trace the upsampling asks for, the cone
 uniforms every cone pass shares, and read-backs for tests and statistics."""

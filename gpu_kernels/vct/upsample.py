@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Reduced-resolution VCT gather brought back to full resolution (inferred lighting, Kircher and Lawrance 2009:
 lighting at a reduced resolution plus discontinuity-aware upsampling).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The VCT grid and its volumes: the grid padded so every mip level nests, the six face volumes the injection
 and the bounces write, the filtered cone volumes the cones read, and binding those to a program."""
 from __future__ import annotations

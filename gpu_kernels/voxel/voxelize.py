@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Surface voxelisation on the GPU (Freed 2018, §4.1): area, albedo·opacity, normal and emission per voxel.
 
 Two methods, as compared in Freed 2018, §5.2.2 / Table 5.2:

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Direct light and Diffuse Color against Cycles, per light type and camera kind (issue: foundation).
 
 Each scene is rendered at 160×120 by Bounce GI and by Cycles (two seeds, 128 spp, settings of docs/conventions.md).

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """LPV against Cycles on the typical interiors (issue: Light Propagation Volumes) — accuracy and regression bounds.
 
 160×120, 32³ grid, Cycles 128 spp × 2 seeds. Two comparisons on each typical interior, as the issue asks: with

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """VCT against full-bounce Cycles on the typical interiors (issue: Voxel Cone Tracing) — regression bounds.
 
 160×120, default VctSettings (64³, 9 cones × 7 sub-rays per pixel, 8 bounces of which 4 gathered with 6 cones) and

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """`bounce-gi bench`: the report's shape on one small example (real Cycles, real renders), the pure parts (Pareto
 front, speed-up interpolation, log-log slope, automatic quality's choice) on constructed inputs, and bad input.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """gpu_kernels.common.camera reproduces Blender's camera exactly (docs/conventions.md, Camera: lens/sensor, sensor fit, shift, pixel
 aspect, ortho scale, clip).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The `bounce-gi` console script as users run it: a real subprocess, real .blend files.
 
 Bad input must give exit code 2, exactly one non-empty stderr line "bounce-gi: error: ..." (no traceback) and

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The example scenes (examples/scenes/): every scene builds, has one camera, light,
 the expected objects and settings; one .blend round-trips; Cycles lights `cornell`.
 

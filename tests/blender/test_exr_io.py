@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """gpu_kernels.output.exr: multi-part EXR in Blender 5's layout (docs/conventions.md, Passes), atomic writes, reading real Blender
 output, and the sRGB preview tone map."""
 import math

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Blender → Scene extraction (addon/extract/) checked against Blender's own numbers.
 
 All bpy work runs in ONE subprocess (tests/support/extraction_probe.py), so Blender state never leaks into the

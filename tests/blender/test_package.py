@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The extension as users get it: manifest validates, zips build, the Linux zip installs into bpy,
 enables (operator, panel, Scene property appear), disables cleanly; register() is repeatable.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The preview operator's steps in background Blender: image writing, panel drawing, and a real
 render of a tiny scene (cube + sun + camera) through addon.extract and the gpu_kernels engine.
 

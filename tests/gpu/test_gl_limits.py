@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Every shader program the pipeline compiles fits the resource limits of real GPU drivers, not only llvmpipe's.
 
 Why: llvmpipe (the CI renderer) allows 32 image units per stage, NVIDIA's driver 8 — the OpenGL 4.3 minimum

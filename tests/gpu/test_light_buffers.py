@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """gpu_kernels.common.lights: CPU records mirror the GLSL structs (std430, checked by parsing and on the GPU),
 area-light polygons, the shadow atlas packer, and the light units of docs/conventions.md."""
 import math

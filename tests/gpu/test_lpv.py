@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """LPV properties that must hold exactly or by construction (issue: Light Propagation Volumes).
 
 - Propagation conserves flux in empty space: far face 0.4006696846 sr + 4 side faces 0.4234313544 sr = 2π/3 per

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Octree LPV (Olovsson and Doggett 2013, gpu_kernels/lpv/octree.py): downsampling, index volume, merge, equivalence, light level.
 
 Grids are small (16³/32³): llvmpipe on shared CPUs.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """gpu_kernels.pass_cache: skip what did not change, release what is replaced; and the real pipeline re-running
 exactly the passes downstream of a change (docs/architecture.md, The pipeline and its pass cache), with the direct light checked against the analytic value."""
 import math

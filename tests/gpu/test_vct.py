@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Voxel Cone Tracing (Crassin et al. 2011; Freed 2018): properties that must hold by construction, with tolerances and their reasons.
 
 (a) White furnace: a closed box whose walls all emit Le and reflect ρ, no lights. Emissive triangles are lights, so

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """VCT specular cone (Freed 2018, §4.5.2) and the passes that come with it: Glossy Indirect, Glossy Color, AO.
 
 Scene: a floor under a wall lit by a horizontal sun (the floor gets no direct light, n·l = 0), so the wall's

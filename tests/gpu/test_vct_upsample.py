@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Reduced-resolution VCT gather and its discontinuity-aware upsampling (inferred lighting, Kircher and Lawrance 2009).
 
 The upsampler (vct/upsample.glsl) is driven directly with fields we choose, on G-buffers rendered from an orthographic

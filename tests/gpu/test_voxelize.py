@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """gpu_kernels.voxel.voxelize + common.grid (Freed 2018, §4.1): coverage against trimesh, exact areas, albedo weighting,
 determinism, fixed-point overflow handling and lattice snapping. Runs on Mesa llvmpipe through EGL (~10 s)."""
 import numpy as np

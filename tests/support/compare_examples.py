@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Render example scenes with Bounce GI and with Cycles (two seeds) and print one JSON line of errors.
 
 Run in a subprocess by the `compare_examples` fixture (tests/conftest.py) for tests/accuracy/, so bpy's global state

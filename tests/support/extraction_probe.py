@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The bpy side of tests/blender/test_extraction.py, run there in ONE subprocess so Blender state never leaks into
 the pytest process:
     python tests/support/extraction_probe.py OUT.json

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The project's import graph, read from the source (no module is imported): which project modules each module
 imports (function-level imports included) and which private names of other modules it uses. Used by
 tests/unit/test_layering.py (the layout's rules) and tests/blender/test_package.py (what the zip must hold)."""

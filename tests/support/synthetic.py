@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Synthetic test scenes built from quads, and exact irradiance oracles (shared by the VCT and LPV tests)."""
 import math
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """gpu_kernels is the pure half (docs/architecture.md, One import direction): importing it, and every module in it, never pulls in bpy or mathutils.
 
 The import check runs in a fresh interpreter so that nothing another test imported (bpy included) can hide or

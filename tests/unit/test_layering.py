@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The layout's rules, read from the source (no imports run): no import cycles, no private names crossing
 modules, one import direction inside the core and between the add-on's parts, and module and function sizes a
 newcomer can read. Function-level imports count like top-level ones: a cycle hidden in a function is a cycle."""
@@ -104,3 +105,11 @@ def test_the_graph_is_not_empty():
     assert GRAPH[f"{PACKAGE}.gpu_kernels.pipeline"] >= {f"{PACKAGE}.gpu_kernels.settings",
                                                          f"{PACKAGE}.gpu_kernels.lpv.passes"}
     assert os.path.basename(FILES[f"{PACKAGE}.gpu_kernels.lpv"]) == "__init__.py"
+
+
+def test_every_source_file_states_its_licence():
+    """The SPDX header (GPL-3.0-or-later, as LICENSE, the manifest and pyproject say) on every Python and GLSL file."""
+    shaders = sorted((ROOT / "gpu_kernels" / "shaders").rglob("*.glsl"))
+    missing = [str(p.relative_to(ROOT)) for p in list(FILES.values()) + shaders
+               if "SPDX-License-Identifier: GPL-3.0-or-later" not in p.read_text(encoding="utf-8")[:200]]
+    assert shaders and missing == []

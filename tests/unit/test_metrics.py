@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """gpu_kernels.output.metrics: rel-L1 and relMSE as docs/conventions.md defines them, masks, and the heat-map ramp."""
 import math
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """gpu_kernels.shader_preprocessor: includes, pragma once, defines, stages, line mapping, logs."""
 from pathlib import Path
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Unshadowed light evaluation shared by direct lighting and RSM flux (one implementation of Cycles' light units).
 #pragma once
 #include "common/lights.glsl"

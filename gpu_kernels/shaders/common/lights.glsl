@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Light and shadow-view records shared by the lighting shaders. Each struct mirrors a numpy dtype in
 // gpu_kernels/common/lights.py field for field (std430); tests/gpu/test_light_buffers.py checks the offsets.
 #pragma once

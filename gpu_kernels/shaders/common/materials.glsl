@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Material inputs of one draw call (see direct/geometry.py: bind_material) and the diffuse albedo they give.
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Buffer records shared by several programs. Each mirrors a numpy dtype field for field (std430: vec4 members only,
 // so the offsets are 16-byte aligned on every driver): Vpl ↔ lpv/gather.py VPL_DTYPE. The light, view and
 // polygon records live with their evaluation in common/lights.glsl.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Vertex stage shared by the programs that rasterise the scene's surfaces with their materials (G-buffer, RSMs):
 // world position, shading normal, UV and geometric normal pass through; one view-projection matrix.
 #pragma once

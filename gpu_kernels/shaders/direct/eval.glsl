@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Shadowed direct irradiance of one light at a point (sun, point, spot, polygon), shared by the Diffuse Direct
 // pass (direct/light.glsl) and VCT radiance injection (vct/inject.glsl), so voxels are lit exactly like pixels.
 // Needs the light/view/polygon buffers of common/lights.glsl and the shadow atlas declared here.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // G-buffer from the scene camera: world position, shading normal, diffuse colour, emission, geometric normal, glossy
 // colour and roughness (the VCT specular cone, vct/specular.glsl).
 // Sampled at pixel centres with no MSAA, like Cycles with a ~0.01 px pixel filter (docs/conventions.md).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Direct diffuse light per pixel from the G-buffer: sun, point, spot (Cycles' smoothstep cone), and polygon lights
 // (area lights and emissive triangles) integrated exactly with Lambert's polygon formula, all shadowed through the
 // shadow atlas. Output is Cycles' Diffuse Direct pass: irradiance/π, albedo divided out (docs/conventions.md).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Depth-only pass for one shadow view (a tile of the shadow atlas). Both faces are drawn: surfaces are two-sided.
 // Perspective views store radial distance / far instead of the hyperbolic z: 24-bit depth then resolves
 // far·2⁻²⁴ everywhere, where hyperbolic depth with near = far·10⁻⁴ would lose most of its bits near the far plane.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Absorbed light per surface voxel: where does the flux that fuzzy occlusion stops go? (Energy-exact LPV lookup.)
 // Propagation stops the fraction B of the flux crossing a face (lpv/propagate.glsl), where B sums the projected
 // area of the surfaces inside the cell-sized box centred on that face — eight fine voxels of half the cell size

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // One more bounce (issue: multiple bounces): every surface voxel reflects the light it absorbed in the last pass,
 // Φ = albedo × E × area per side, as a Lambertian VPL (Φ/π)·lobe(±n) half a cell in front of that side —
 // the same injection as an RSM texel (lpv/inject.glsl), so the next propagation carries the next bounce.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The next bounce's VPLs for the gathered transport (LpvSettings.transport = "gather"): every surface voxel reflects
 // the light it received in the last pass, Φ = albedo × E × area per side (as lpv/bounce.glsl injects it), and the
 // voxels of one S×S×S block are clustered into at most three VPLs, so that a gather costs a few hundred VPLs rather

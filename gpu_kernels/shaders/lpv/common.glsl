@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Two-band spherical harmonics and the LPV grid (Kaplanyan and Dachsbacher 2010; Kaplanyan 2009). SH basis and
 // conventions: docs/conventions.md; the clamped-cosine coefficients are Ramamoorthi and Hanrahan 2001's.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Fixed-point accumulation of LPV injections (no float atomics here): 12 ints per cell, RGB × 4 SH coefficients,
 // scaled by u_fixed_scale (lpv/state.py: FIXED_RANGE / a bound of the flux, so sums stay below 2³¹).
 #pragma once

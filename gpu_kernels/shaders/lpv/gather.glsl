@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Gathered transport (LpvSettings.transport = "gather"): the irradiance every surface voxel receives straight from a
 // list of VPLs — the RSM's for the first bounce, the surface voxels' own clusters for each further one
 // (lpv/cluster.glsl) — instead of through the propagation.

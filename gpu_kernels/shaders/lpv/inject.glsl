@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // LPV injection (Elvek 2012, §3.3; Kaplanyan 2009): every RSM texel is a VPL of flux Φ = albedo × (irradiance × texel
 // area); its intensity (Φ/π)·max(0, n·ω) is projected on 2-band SH and added to the cell half a cell in front of it.
 // Accumulation is exact fixed point (integer atomics; no float atomics here), scaled by u_fixed_scale. Because Φ

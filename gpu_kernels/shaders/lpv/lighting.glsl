@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Diffuse Indirect from the LPV. Two estimators of irradiance E at a surface point with normal n:
 //
 // MODE_FLUX (default): the irradiance of the surface voxels near the point, from the flux fuzzy occlusion stopped

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Octree LPV downsampling (Olovsson and Doggett 2013, §3.2, Eq. 2): O_i(x) from the eight elements
 // O_{i-1}([2x, 2x+1], ...).
 // Eq. 2 averages, to keep "a uniform range of light intensities" across levels for a state that is a density.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Octree LPV merge (Olovsson and Doggett 2013, §3.4): M(x) = S(x), one O_0-sized volume that the unchanged
 // lighting step reads.
 // S (Eq. 1): I(x) = min_i I_i(x >> i) over the index hierarchy (§3.1), then sample O_{I(x)}(x >> I(x)).

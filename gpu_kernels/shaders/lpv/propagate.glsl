@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // One LPV propagation step, gathering (Kaplanyan and Dachsbacher 2010; Elvek 2012, §3.3.1; Kaplanyan 2009, §N.5).
 // Each cell receives light from its six neighbours. From a neighbour, light reaches the five faces of this cell
 // that do not touch it: the far face subtends 0.4006696846 sr from the neighbour's centre and each side face

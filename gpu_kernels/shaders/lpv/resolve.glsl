@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Fixed-point injection sums (12 ints per cell) → three RGBA32F volumes of SH coefficients (red, green, blue).
 // MODE_ADD adds the injected light to what the volumes already hold (used by world light and bounces).
 #include "lpv/common.glsl"

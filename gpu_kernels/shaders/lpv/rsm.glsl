@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Reflective shadow map (Dachsbacher and Stamminger 2005; Elvek 2012, §3.1): from one shadow view of a light, store the
 // surfels the light sees — world position (w = view index + 1), normal facing the light, diffuse albedo. The
 // injection pass turns each texel into a VPL whose flux it derives from these and the light's units.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // World (sky) light enters the LPV through the open faces of the grid's border (issue: world light). A constant
 // world radiance L_w crossing a face of area s² over a hemisphere carries flux π·L_w·s² inward; it is injected into
 // the border cell as a Lambertian lobe about the inward normal, (Φ/π)·lobe = L_w·s²·lobe, times the fraction of

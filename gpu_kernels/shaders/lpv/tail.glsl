@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The extrapolated bounce tail of the gathered transport (lpv/gather.py gather_all): bounces K+1 … N without
 // gathering them, as the last gathered pass's irradiance times u_tail (r = the flux ratio of the next bounce's VPLs
 // to the last one's; common/bounce_tail.glsl).

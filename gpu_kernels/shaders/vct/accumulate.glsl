@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Temporal accumulation of the VCT diffuse gather (vct/temporal.py). Frame k (0-based) of a static view turns the
 // cone set by another angle; the history holds the running mean of frames 0..k:
 //   H_k = H_{k−1} + (C_k − H_{k−1}) / (k + 1)      (H_0 = C_0, so the first frame after a reset is a fresh render)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Access to arrays of six textures / images by a non-constant index, through switches whose cases index with
 // constants. Why: GLSL only allows dynamically uniform indices into opaque arrays, and llvmpipe (Mesa 22) takes the
 // index from one SIMD lane: once lanes diverge (an early return for empty voxels or background pixels), a loop

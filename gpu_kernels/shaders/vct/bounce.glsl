@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // VCT multiple bounces (Freed 2018 traces cones from pixels only; gathering at the voxels too is the same estimator
 // applied to the voxel faces): each occupied voxel face g gathers the irradiance E_g arriving over the hemisphere
 // of its outward normal from the current radiance volumes (vct/common.glsl), and its outgoing radiance becomes

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The extrapolated bounce tail of vct/bounce.py on one voxel face volume (common/bounce_tail.glsl):
 //   L_N = L_K + (L_K − L_(K−1)) · u_tail   (rgb; u_tail from the face flux)
 // in place on L_K; the coverage α is kept. Run once per face direction.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Voxel cone tracing (Crassin et al. 2011; Freed 2018, §3.4, §4.5.2): the grid, the cone table, one cone step through
 // the filtered radiance volumes, and the cosine-weighted hemisphere gather shared by the per-voxel bounce pass
 // (vct/bounce.glsl) and the per-pixel trace (vct/trace.glsl). gpu_kernels/vct/ (settings.py, cones.py) documents

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Per-pixel diffuse cones as bundles of sub-rays that meet surfaces where they cross them (MODE_CROSSING, anisotropic
 // volumes only; included by vct/common.glsl). vct/trace.glsl uses it; the bounce gathers keep trace_cone.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // VCT radiance injection, compute half (the surface points are rasterised by vct/inject_raster.glsl).
 //
 // Per direction, not per side of the voxel normal: the voxelizer's normal is a mean of sign-canonicalised normals,

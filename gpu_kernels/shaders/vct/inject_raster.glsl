@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // VCT radiance injection from real surface points (Freed 2018, §4.3, injects the lit surface points of the shadow map;
 // here every surface point is rasterised, lit or not, so shadowed faces get their 0 too).
 //

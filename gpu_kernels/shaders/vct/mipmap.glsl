@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // VCT radiance filtering (Freed 2018, §4.4: "a compute shader kernel is launched for each level ... averaging the
 // surrounding 8 values"). Volumes store optical depth and τ-weighted radiance, rgb = τ·S, a = τ:
 //   τ = optical depth of crossing one texel of that level (along the volume's axis when anisotropic),

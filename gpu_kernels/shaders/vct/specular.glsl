@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // VCT specular cone (Freed 2018, §4.5.2: "five [cones] for diffuse light and one for a specular highlight", oriented
 // along reflect(−v, n)): one glossy cone per G-buffer pixel → Glossy Indirect, the radiance arriving from around the
 // mirror direction, i.e. the reflected light divided by Glossy Color as in Cycles' pass (docs/conventions.md).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // VCT final gather per G-buffer pixel (Freed 2018, §4.5.2, Algorithm 3): diffuse cones over the hemisphere of the
 // shading normal, started from the geometric tangent plane (vct/common.glsl). Output: rgb = Diffuse Indirect
 // (irradiance / π, albedo divided out as in Cycles' pass, docs/conventions.md), a = voxel ambient occlusion

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Discontinuity-aware upsampling of the reduced-resolution VCT gather (inferred lighting, Kircher and Lawrance 2009:
 // light at a reduced resolution, with the bilinear filter biased by depth and a surface ID so light does not bleed
 // across object edges). Here the low-resolution texels are the gathers at G-buffer pixels i·s + s/2 (vct/trace.glsl),

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Shared by voxel/raster.glsl and voxel/tess.glsl: material inputs and the fixed-point deposit of one
 // surface piece into the voxel accumulators (Freed 2018, §4.1: "we average the resulting color value using atomic
 // operations"). There are no float atomics in GL 4.5, so every quantity is summed as an integer: uint atomics

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Rasterisation-based surface voxelisation (Freed 2018, §4.1.1, after Crassin and Green 2012).
 //
 // Geometry shader: project each triangle along the dominant axis of its normal (Algorithm 1) onto a plane

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Compute passes around voxelisation (Freed 2018, §4.1): MODE_CLEAR zeroes the fixed-point accumulators,
 // MODE_RESOLVE turns their integer sums (voxel/common.glsl) into the RGBA32F volumes:
 //   area     rgb = Σ A|n.x|, Σ A|n.y|, Σ A|n.z| (m²), a = Σ A (m²)

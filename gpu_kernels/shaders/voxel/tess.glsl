@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Tessellation-based surface voxelisation (Freed 2018, §4.1.2; Fei et al. 2012): no rasterisation.
 //
 // The control shader picks tessellation levels from the triangle's size in voxels so that every generated
