@@ -13,6 +13,12 @@ def set_uniform(prog, name, value):
         prog[name].value = value
 
 
+def set_uniforms(prog, values: dict) -> None:
+    """set_uniform for every (name, value) of `values`."""
+    for name, value in values.items():
+        set_uniform(prog, name, value)
+
+
 def write_uniform(prog, name, array: np.ndarray) -> None:
     """Write a uniform (array, matrix) as raw float32 bytes if the compiler kept it."""
     if name in prog:
@@ -54,6 +60,18 @@ def dispatch(prog, size, local: int = 4) -> None:
     """Run a compute program over `size` (1 to 3 axes) with `local`-wide work groups on every axis given."""
     g = groups(size, local)
     prog.run(*(g + (1,) * (3 - len(g))))
+
+
+def dispatch_counted(ctx, prog, size, local: int = 8) -> int:
+    """dispatch() a program that counts what it did in an atomic uint on storage buffer 3; returns the count."""
+    counter = ctx.buffer(np.zeros(4, np.uint32).tobytes())
+    try:
+        counter.bind_to_storage_buffer(3)
+        dispatch(prog, size, local)
+        ctx.memory_barrier()
+        return int(np.frombuffer(counter.read(), np.uint32)[0])
+    finally:
+        counter.release()
 
 
 def bind_grid(prog, grid, levels: int | None = None) -> None:

@@ -9,7 +9,7 @@ import math
 import numpy as np
 
 from ..direct.geometry import draw_by_material
-from ..gl.bind import bind_grid, bind_lights, bind_samplers, dispatch, set_uniform, texture3d
+from ..gl.bind import bind_grid, bind_lights, bind_samplers, dispatch, set_uniform, set_uniforms, texture3d
 from ..scene import Scene
 from .volumes import Faces
 
@@ -39,8 +39,7 @@ def inject(ctx, programs, scene: Scene, geometry, textures: list, vox, shadows, 
         side = max(grid.size) * INJECT_SAMPLES
         bind_grid(prog, grid, 1)
         bind_lights(prog, shadows, unit=2)
-        for name, value in (("u_samples", float(INJECT_SAMPLES)), ("u_viewport", (float(side), float(side)))):
-            set_uniform(prog, name, value)
+        set_uniforms(prog, {"u_samples": float(INJECT_SAMPLES), "u_viewport": (float(side), float(side))})
         acc.bind_to_image(0, read=True, write=True)
         vao = ctx.vertex_array(prog, [(geometry.vbo, "3f 12x 2f 12x", "in_position", "in_uv")])
         fbo = ctx.empty_framebuffer((side, side))

@@ -18,7 +18,7 @@ import math
 
 import numpy as np
 
-from ..gl.bind import bind_samplers, dispatch, set_uniform
+from ..gl.bind import bind_samplers, dispatch_counted, set_uniforms
 from .settings import VctSettings
 from .trace import bind_cones
 from .volumes import ConeVolumes, Faces, bind_volumes
@@ -45,17 +45,7 @@ def specular(ctx, programs, gbuffer, faces: Faces, volumes: ConeVolumes, s: VctS
     for name in ("position", "normal", "geo_normal", "glossy"):
         unit = bind_samplers(prog, f"u_{name}", [gbuffer.textures[name]], unit)
     bind_cones(prog, volumes.grid, volumes.levels, s, world)
-    for name, value in (("u_image_size", (w, h)), ("u_camera_position", gbuffer.eye),
-                        ("u_camera_forward", gbuffer.forward), ("u_camera_ortho", bool(gbuffer.ortho)),
-                        ("u_roughness_cutoff", float(s.roughness_cutoff))):
-        set_uniform(prog, name, value)
-    counter = ctx.buffer(np.zeros(4, np.uint32).tobytes())
-    try:
-        counter.bind_to_storage_buffer(3)
-        out.bind_to_image(0, read=False, write=True)
-        dispatch(prog, (w, h), local=8)
-        ctx.memory_barrier()
-        traced = int(np.frombuffer(counter.read(), np.uint32)[0])
-    finally:
-        counter.release()
-    return {"glossy": out, "traced": traced}
+    set_uniforms(prog, {"u_image_size": (w, h), "u_camera_position": gbuffer.eye, "u_camera_forward": gbuffer.forward,
+                        "u_camera_ortho": bool(gbuffer.ortho), "u_roughness_cutoff": float(s.roughness_cutoff)})
+    out.bind_to_image(0, read=False, write=True)
+    return {"glossy": out, "traced": dispatch_counted(ctx, prog, (w, h))}

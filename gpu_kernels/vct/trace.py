@@ -9,7 +9,7 @@ import math
 import numpy as np
 
 from ..common.grid import Grid
-from ..gl.bind import bind_grid, bind_samplers, dispatch, read_texture, set_uniform, write_uniform
+from ..gl.bind import bind_grid, bind_samplers, dispatch, read_texture, set_uniform, set_uniforms, write_uniform
 from .cones import MAX_CONES, cone_table, subray_radius
 from .settings import VctSettings
 from .volumes import ConeVolumes, Faces, bind_volumes
@@ -26,10 +26,9 @@ def bind_cones(prog, grid: Grid, levels: int, s: VctSettings, world) -> None:
     write_uniform(prog, "u_cones", cones)
     write_uniform(prog, "u_cone_tan", tan)
     bind_grid(prog, grid, levels)
-    for name, value in (("u_cone_count", n), ("u_step", float(s.step_multiplier)),
-                        ("u_offset", float(s.start_offset)), ("u_max_distance", float(s.max_distance)),
-                        ("u_ao_distance", float(s.ao_distance)), ("u_world", tuple(float(c) for c in world[:3]))):
-        set_uniform(prog, name, value)
+    set_uniforms(prog, {"u_cone_count": n, "u_step": float(s.step_multiplier), "u_offset": float(s.start_offset),
+                        "u_max_distance": float(s.max_distance), "u_ao_distance": float(s.ao_distance),
+                        "u_world": tuple(float(c) for c in world[:3])})
 
 
 def trace(ctx, programs, gbuffer, faces: Faces, volumes: ConeVolumes, s: VctSettings, world,

@@ -10,9 +10,7 @@ benchmarks/vct_bench.py.
 """
 from __future__ import annotations
 
-import numpy as np
-
-from ..gl.bind import bind_samplers, dispatch, set_uniform
+from ..gl.bind import bind_samplers, dispatch_counted, set_uniforms
 from .trace import fixup
 
 SIGMA_VOXELS = 0.5  # plane-distance scale in voxels (vct/upsample.glsl says why)
@@ -37,16 +35,7 @@ def joint_bilateral(ctx, programs, gbuffer, low, scale: int, sigma: float):
     unit = bind_samplers(prog, "u_low", [low], 0)
     for name in ("position", "normal"):
         unit = bind_samplers(prog, f"u_{name}", [gbuffer.textures[name]], unit)
-    for name, value in (("u_image_size", (w, h)), ("u_low_size", tuple(low.size)), ("u_scale", int(scale)),
-                        ("u_sigma", float(sigma))):
-        set_uniform(prog, name, value)
-    counter = ctx.buffer(np.zeros(4, np.uint32).tobytes())
-    try:
-        counter.bind_to_storage_buffer(3)
-        out.bind_to_image(0, read=False, write=True)
-        dispatch(prog, (w, h), local=8)
-        ctx.memory_barrier()
-        marked = int(np.frombuffer(counter.read(), np.uint32)[0])
-    finally:
-        counter.release()
-    return out, marked
+    set_uniforms(prog, {"u_image_size": (w, h), "u_low_size": tuple(low.size), "u_scale": int(scale),
+                        "u_sigma": float(sigma)})
+    out.bind_to_image(0, read=False, write=True)
+    return out, dispatch_counted(ctx, prog, (w, h))

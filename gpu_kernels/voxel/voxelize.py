@@ -25,7 +25,7 @@ import numpy as np
 from ..common.grid import Grid
 from ..direct.geometry import bind_material
 from ..gl import preprocessor as spp
-from ..gl.bind import bind_images, bind_named, dispatch, set_uniform
+from ..gl.bind import bind_images, bind_named, dispatch, set_uniform, set_uniforms
 from ..scene import Scene
 
 MODES = ("raster", "tessellation")
@@ -248,9 +248,8 @@ def _draw_raster(ctx, programs, scene, geometry, textures, grid, supersample, un
 
     prog = programs.raster("voxel/raster.glsl")
     side = max(grid.size) * supersample
-    for name, value in {**uniforms, "u_viewport": (float(side), float(side)), "u_dilation": DILATION_PX,
-                        "u_supersample_i": supersample}.items():
-        set_uniform(prog, name, value)
+    set_uniforms(prog, {**uniforms, "u_viewport": (float(side), float(side)), "u_dilation": DILATION_PX,
+                        "u_supersample_i": supersample})
     fbo = ctx.empty_framebuffer((side, side))
     vao = ctx.vertex_array(prog, [(geometry.vbo, "3f 12x 2f 12x", "in_position", "in_uv")])
     try:
@@ -270,8 +269,7 @@ def _draw_tessellated(ctx, programs, scene, buffers, textures, uniforms) -> None
 
     vbo, ranges = buffers
     prog = tessellation_program(programs, "voxel/tess.glsl")
-    for name, value in {**uniforms, "u_max_level": float(MAX_TESS_LEVEL)}.items():
-        set_uniform(prog, name, value)
+    set_uniforms(prog, {**uniforms, "u_max_level": float(MAX_TESS_LEVEL)})
     vao = ctx.vertex_array(prog, [(vbo, "3f 12x 2f 12x", "in_position", "in_uv")])
     fbo = ctx.empty_framebuffer((1, 1))   # draws need a complete framebuffer even with the rasteriser off
     ctx.enable(moderngl.RASTERIZER_DISCARD)   # §4.1.2: no rasterisation; the geometry shader writes the voxels
@@ -328,9 +326,8 @@ def _resolve(ctx, programs, accs, grid, scale_bits, albedo_max, emission_max) ->
     bind_named(prog, list(zip(("u_acc_area", "u_acc_albedo", "u_acc_normal", "u_acc_emission"), accs)))
     bind_images(out)
     cell_area = grid.cell ** 2
-    for name, value in {"u_grid_size": grid.size, "u_unit_area": cell_area / 2.0 ** scale_bits, "u_cell_area": cell_area,
-                        "u_albedo_max": albedo_max, "u_emission_max": emission_max}.items():
-        set_uniform(prog, name, value)
+    set_uniforms(prog, {"u_grid_size": grid.size, "u_unit_area": cell_area / 2.0 ** scale_bits, "u_cell_area": cell_area,
+                        "u_albedo_max": albedo_max, "u_emission_max": emission_max})
     dispatch(prog, (nx, ny, nz))
     ctx.memory_barrier()
     return out
