@@ -38,9 +38,10 @@ demo: setup
 test: setup
 	$(PY) -m pytest -q
 
-# The unit and GPU tests alone (no Blender, no Cycles): the quick loop while editing the core.
+# The unit and GPU tests alone (no Blender, no Cycles), on two worker processes: the quick loop while editing the
+# core. (make test stays in one process: the accuracy tests share their Cycles references within a session.)
 test-fast: setup
-	$(PY) -m pytest -q -m "unit or gpu"
+	$(PY) -m pytest -q -n 2 -m "unit or gpu"
 
 # The committed benchmark (benchmarks/results/<renderer>/): example scenes at 160x120 against Cycles (± OIDN) and
 # EEVEE (its timed second render takes ~70 s per scene here), incremental updates, scaling; its quality table
