@@ -42,14 +42,36 @@ class Engine:
         """Drop every cached pass result (the next render runs every pass), on the GPU thread."""
         self.worker.call(lambda ctx: self._pipeline.cache.clear() if self._pipeline else None)
 
+    def shutdown(self) -> None:
+        """Release the pipeline's GL objects and the context on the worker thread, then stop the thread (after the
+        renders already queued). Safe to call twice; the engine cannot render afterwards."""
+        def release(ctx):
+            pipeline, self._pipeline = self._pipeline, None
+            if pipeline is not None:
+                pipeline.release()
+
+        self.worker.shutdown(cleanup=release)
+
     def gl_info(self) -> dict:
         return self.worker.call(lambda ctx: {"renderer": ctx.info["GL_RENDERER"], "version": ctx.version_code})
 
 
 def get_engine() -> Engine:
-    """The shared engine (created on first use)."""
+    """The shared engine (created on first use, and again after shutdown_engine())."""
     global _engine
     with _lock:
         if _engine is None:
             _engine = Engine()
         return _engine
+
+
+def shutdown_engine() -> None:
+    """Shut the shared engine down, if there is one: its pipeline (pass cache, programs) and GL context are
+    released on its worker thread, the thread stops, and the next get_engine() makes a fresh engine. The extension
+    calls this when it is disabled, so no thread, context or cached result outlives it. Safe to call twice or before
+    any engine was made; waits for a render that is running."""
+    global _engine
+    with _lock:
+        engine, _engine = _engine, None
+    if engine is not None:
+        engine.shutdown()

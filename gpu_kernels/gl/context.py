@@ -52,12 +52,18 @@ class GpuWorker:
         self._jobs: queue.Queue = queue.Queue()
         self._ctx = None
         self._ctx_error: BaseException | None = None
+        self._closed = False
+        self._submit_lock = threading.Lock()  # a job is never queued behind the shutdown sentinel
         self._thread = threading.Thread(target=self._loop, name="bounce-gi-gpu", daemon=True)
         self._thread.start()
 
     def submit(self, fn, *args, **kwargs) -> Future:
+        """Queue `fn(ctx, *args, **kwargs)`; RuntimeError once the worker is shut down (the job would never run)."""
         future: Future = Future()
-        self._jobs.put((future, fn, args, kwargs))
+        with self._submit_lock:
+            if self._closed:
+                raise RuntimeError("the Bounce GI GPU worker has been shut down")
+            self._jobs.put((future, fn, args, kwargs))
         return future
 
     def call(self, fn, *args, **kwargs):
@@ -71,8 +77,8 @@ class GpuWorker:
     def _loop(self) -> None:
         while True:
             future, fn, args, kwargs = self._jobs.get()
-            if fn is None:  # shutdown sentinel
-                future.set_result(None)
+            if fn is None:  # shutdown sentinel: args = (cleanup,)
+                self._close_context(future, *args)
                 return
             if not future.set_running_or_notify_cancel():
                 continue
@@ -88,12 +94,33 @@ class GpuWorker:
             except BaseException as exc:
                 future.set_exception(exc)
 
-    def shutdown(self) -> None:
-        """Release the context and stop the thread (waits for queued jobs)."""
-        def release(ctx):
-            ctx.release()
-        if self._ctx is not None:
-            self.submit(release).result()
-        done: Future = Future()
-        self._jobs.put((done, None, (), {}))
-        done.result()
+    def _close_context(self, done: Future, cleanup) -> None:
+        """On the worker thread, last: `cleanup(ctx)` and the context's release, if a context was ever made."""
+        ctx, self._ctx = self._ctx, None
+        try:
+            if ctx is not None:
+                try:
+                    if cleanup is not None:
+                        cleanup(ctx)
+                finally:
+                    ctx.release()
+            done.set_result(None)
+        except BaseException as exc:
+            done.set_exception(exc)
+
+    def shutdown(self, cleanup=None, timeout: float | None = 30.0) -> None:
+        """Stop the thread after the jobs already queued; on it, first `cleanup(ctx)` (release the GL objects made
+        with the context) and then the context itself — neither runs if no job ever made a context.
+
+        Safe to call twice. Later submits raise RuntimeError. Waits up to `timeout` seconds for the thread (a job
+        that is running cannot be interrupted) and re-raises an error of the cleanup.
+        """
+        with self._submit_lock:
+            if self._closed:
+                return
+            self._closed = True
+            done: Future = Future()
+            self._jobs.put((done, None, (cleanup,), {}))
+        self._thread.join(timeout)
+        if done.done():
+            done.result()
