@@ -1,5 +1,6 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""Sidebar panels in the 3D View (N panel, tab "Bounce GI"): settings, render button, last result.
+"""Sidebar panels in the 3D View (N panel, tab "Bounce GI"): settings, render button, last result; and the
+Render Properties panel shown while Bounce GI is the render engine (same settings, same draw function).
 
 Panels only read state; everything they show about the last render comes from
 `preview.state`, which lives in memory and is never written into the .blend.
@@ -15,6 +16,19 @@ def _format_seconds(seconds: float) -> str:
     return f"{seconds * 1000:.1f} ms" if seconds < 10 else f"{seconds:.1f} s"
 
 
+def draw_render_settings(layout, settings) -> None:
+    """The settings F12 and the preview share: time budget and method (what render_settings_of() reads). Both the
+    sidebar and the Render Properties panel draw them with this."""
+    layout.use_property_split = True
+    layout.use_property_decorate = False
+    layout.prop(settings, "use_time_budget")
+    if settings.use_time_budget:
+        layout.prop(settings, "time_budget_ms")
+    row = layout.row()
+    row.enabled = not settings.use_time_budget  # the budget picks the method
+    row.prop(settings, "method")
+
+
 class VIEW3D_PT_bounce_gi(Panel):
     """Bounce GI settings and the Render Preview button."""
 
@@ -25,16 +39,8 @@ class VIEW3D_PT_bounce_gi(Panel):
 
     def draw(self, context):
         layout = self.layout
-        layout.use_property_split = True
-        layout.use_property_decorate = False
         settings = context.scene.bounce_gi
-
-        layout.prop(settings, "use_time_budget")
-        if settings.use_time_budget:
-            layout.prop(settings, "time_budget_ms")
-        row = layout.row()
-        row.enabled = not settings.use_time_budget  # the budget picks the method
-        row.prop(settings, "method")
+        draw_render_settings(layout, settings)
         layout.prop(settings, "resolution_percentage")
         layout.prop(settings, "output_path")
 
@@ -95,7 +101,25 @@ class VIEW3D_PT_bounce_gi_last_render(Panel):
                 box_col.label(text=text, icon="ERROR")
 
 
-classes = (VIEW3D_PT_bounce_gi, VIEW3D_PT_bounce_gi_last_render)
+class RENDER_PT_bounce_gi(Panel):
+    """Render Properties with the Bounce GI engine: what F12 and `blender -b -E BOUNCE_GI` render with. The render
+    size is the scene's (Format panel), so the preview's resolution and Output settings are not shown here."""
+
+    bl_space_type = "PROPERTIES"
+    bl_region_type = "WINDOW"
+    bl_context = "render"
+    bl_label = "Bounce GI"
+    COMPAT_ENGINES = {"BOUNCE_GI"}
+
+    @classmethod
+    def poll(cls, context):
+        return context.engine in cls.COMPAT_ENGINES
+
+    def draw(self, context):
+        draw_render_settings(self.layout, context.scene.bounce_gi)
+
+
+classes = (VIEW3D_PT_bounce_gi, VIEW3D_PT_bounce_gi_last_render, RENDER_PT_bounce_gi)
 
 
 def register():

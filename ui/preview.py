@@ -4,7 +4,9 @@
 The operator (operators.py) only schedules these steps: start_render() extracts the scene and
 submits it to the engine, finish_render() waits for the Future, writes the image and, when the
 Output setting names a file, the render passes as a multi-layer EXR. Keeping them plain lets tests
-run a whole preview in background mode, where modal operators never run.
+run a whole preview in background mode, where modal operators never run. The render engine
+(render_engine.py, F12 and batch) shares the middle of it: submit_scene() (extract, turn the
+settings into RenderSettings with render_settings_of(), submit) and wait_result().
 
 Engine and extraction modules are imported inside the functions, so registering the UI never
 needs moderngl (a missing wheel shows up as one error line when rendering, not as a failed
@@ -108,39 +110,55 @@ def preview_resolution(scene, percentage: int) -> tuple[int, int]:
 
 
 def start_render(scene, depsgraph) -> PendingRender:
-    """Extract `scene` (must run on the main thread) and submit it; returns without waiting."""
+    """Extract `scene` (must run on the main thread) at the preview size and submit it; returns without waiting.
+    A bad Output path fails first, before anything renders."""
+    settings = scene.bounce_gi
+    output = output_file(settings.output_path)
+    pending = submit_scene(depsgraph, preview_resolution(scene, settings.resolution_percentage))
+    pending.output = output
+    return pending
+
+
+def submit_scene(depsgraph, resolution: tuple[int, int]) -> PendingRender:
+    """Extract the depsgraph's scene at `resolution` (W, H) on the main thread and submit it to the engine with the
+    scene's Bounce GI settings (render_settings); returns without waiting. What the preview and the render engine
+    (render_engine.py) share. PreviewError, one line, for every failure: engine not importable, extraction, bad
+    input, a method that is not implemented."""
     try:
         from ..addon.extract import ExtractError, extract_scene
         from ..gpu_kernels.engine import get_engine
-        from ..gpu_kernels.settings import RenderSettings
     except ImportError as ex:
         raise PreviewError(f"Bounce GI engine unavailable: {one_line(ex)}") from None
 
-    settings = scene.bounce_gi
-    output = output_file(settings.output_path)  # a bad path fails here, before anything renders
-    method = settings.method_id()
-    width, height = preview_resolution(scene, settings.resolution_percentage)
     try:
-        scene_data = extract_scene(depsgraph, resolution=(width, height))
+        scene_data = extract_scene(depsgraph, resolution=resolution)
     except ExtractError as ex:
         raise PreviewError(one_line(ex)) from None
     except Exception as ex:
         raise _unexpected(ex, "scene extraction") from None
     # Extraction owns the final size (it may clamp it); render exactly what it describes.
     width, height = (int(v) for v in scene_data.resolution)
-    render_settings, quality = RenderSettings(method=method, width=width, height=height), ""
-    if settings.use_time_budget:
-        render_settings, quality = budget_settings(settings.time_budget_ms, width, height)
-        method = render_settings.method
+    render_settings, quality = render_settings_of(depsgraph.scene.bounce_gi, width, height)
     try:
         future = get_engine().submit_render(scene_data, render_settings)
     except NotImplementedError as ex:
-        raise _not_implemented(ex, method) from None
+        raise _not_implemented(ex, render_settings.method) from None
     except _user_facing_errors() as ex:
         raise PreviewError(one_line(ex)) from None
     except Exception as ex:
         raise _unexpected(ex, "render submission") from None
-    return PendingRender(future, method, width, height, list(scene_data.warnings), quality=quality, output=output)
+    return PendingRender(future, render_settings.method, width, height, list(scene_data.warnings), quality=quality)
+
+
+def render_settings_of(settings, width: int, height: int):
+    """The engine's RenderSettings for a scene's Bounce GI settings (properties.BounceGISettings) at width × height:
+    the chosen method with its default settings, or, with the time budget on, what the quality table picks for it.
+    Returns (settings, the budget's one-line explanation or "")."""
+    from ..gpu_kernels.settings import RenderSettings
+
+    if settings.use_time_budget:
+        return budget_settings(settings.time_budget_ms, width, height)
+    return RenderSettings(method=settings.method_id(), width=width, height=height), ""
 
 
 def output_file(path: str) -> str:
@@ -191,13 +209,13 @@ def budget_settings(budget_ms: float, width: int, height: int):
     return render_settings_for(choice, width, height), choice.describe(table)
 
 
-def finish_render(pending: PendingRender, timeout: float | None = None) -> RenderReport:
-    """Wait for the engine, write the Combined pass into the preview image, record the report, write the passes
-    to the Output file if one is set."""
+def wait_result(pending: PendingRender, timeout: float | None = None):
+    """The RenderResult of a submitted render, waiting up to `timeout` seconds (None: as long as it takes);
+    PreviewError, one line, when it failed, was cancelled or did not finish in time."""
     import concurrent.futures
 
     try:
-        result = pending.future.result(timeout=timeout)
+        return pending.future.result(timeout=timeout)
     except NotImplementedError as ex:
         raise _not_implemented(ex, pending.method) from None
     except _user_facing_errors() as ex:
@@ -209,6 +227,11 @@ def finish_render(pending: PendingRender, timeout: float | None = None) -> Rende
     except Exception as ex:
         raise _unexpected(ex, "render") from None
 
+
+def finish_render(pending: PendingRender, timeout: float | None = None) -> RenderReport:
+    """Wait for the engine, write the Combined pass into the preview image, record the report, write the passes
+    to the Output file if one is set."""
+    result = wait_result(pending, timeout)
     if "Combined" not in result.passes:
         raise PreviewError(f"Bounce GI engine returned no Combined pass (got {sorted(result.passes)})")
     write_preview_image(result.passes["Combined"])

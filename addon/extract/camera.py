@@ -26,10 +26,12 @@ def read_camera(scene) -> Camera:
 
 
 def render_resolution(render, resolution=None) -> tuple[int, int]:
-    """`resolution` (W, H) if given, else the scene's render size after its resolution percentage."""
+    """`resolution` (W, H) if given, else the scene's render size after its resolution percentage, in integers as
+    Blender computes it (size · percentage / 100, rounded down: 100 px at 29 % is 29 px, where 100 · 0.29 in floats
+    is 28.999…)."""
     if resolution is None:
-        pct = render.resolution_percentage / 100.0
-        resolution = (max(1, int(render.resolution_x * pct)), max(1, int(render.resolution_y * pct)))
+        pct = render.resolution_percentage
+        resolution = (max(1, render.resolution_x * pct // 100), max(1, render.resolution_y * pct // 100))
     return tuple(int(v) for v in resolution)
 
 

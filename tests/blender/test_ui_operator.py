@@ -107,6 +107,16 @@ def test_panels_draw_with_valid_names(tmp_path):
         assert ("label", "cached") in seen and ("label", "material 'X' fell back") in seen
         assert {("prop", "method"), ("prop", "resolution_percentage"), ("prop", "output_path")} <= set(seen)
 
+        # Render Properties, with Bounce GI as the engine: the same settings, not the preview's size or Output.
+        seen.clear()
+        assert panel.RENDER_PT_bounce_gi.poll(SimpleNamespace(engine="BOUNCE_GI"))
+        assert not panel.RENDER_PT_bounce_gi.poll(SimpleNamespace(engine="CYCLES"))
+        bpy.context.scene.bounce_gi.use_time_budget = True
+        panel.RENDER_PT_bounce_gi.draw(SimpleNamespace(layout=Layout()), ctx)
+        print("render properties", seen)
+        assert seen == [("prop", "use_time_budget"), ("prop", "time_budget_ms"), ("prop", "method")], seen
+        bpy.context.scene.bounce_gi.use_time_budget = False
+
         # Opening another file forgets the last render (its times would describe another scene).
         bpy.ops.wm.read_homefile(use_empty=True)
         print("after load:", preview.state.last, preview.state.last_error)
