@@ -179,8 +179,12 @@ def test_register_unregister_twice(tmp_path):
             bounce_gi.register()
             assert hasattr(bpy.types.Scene, "bounce_gi") and hasattr(bpy.types, "BOUNCE_GI_OT_render_preview")
             s = bpy.context.scene.bounce_gi
-            assert (s.method, s.resolution_percentage, s.output_path) == ("VCT", 50, "//bounce_gi.exr")
+            assert (s.method, s.resolution_percentage, s.output_path) == ("VCT", 50, "")
+            assert bounce_gi.ui.render_engine.BounceGIRenderEngine.is_registered
+            assert "BOUNCE_GI" in bpy.types.DATA_PT_light.COMPAT_ENGINES
             bounce_gi.unregister()
+            assert not bounce_gi.ui.render_engine.BounceGIRenderEngine.is_registered
+            assert "BOUNCE_GI" not in bpy.types.DATA_PT_light.COMPAT_ENGINES
             assert not hasattr(bpy.types.Scene, "bounce_gi")
             assert not hasattr(bpy.types, "BOUNCE_GI_OT_render_preview")
             assert not hasattr(bpy.types, "VIEW3D_PT_bounce_gi")
