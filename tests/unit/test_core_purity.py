@@ -16,6 +16,9 @@ import pytest
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 CORE = os.path.join(ROOT, "gpu_kernels")
 FORBIDDEN = ("bpy", "mathutils", "bmesh", "gpu", "bgl")
+# Every module of the core, in its subpackages too, as paths relative to gpu_kernels/.
+CORE_FILES = sorted(os.path.relpath(os.path.join(d, f), CORE) for d, _, files in os.walk(CORE) for f in files
+                    if f.endswith(".py"))
 
 
 def test_importing_every_gpu_kernels_module_loads_no_blender_module():
@@ -34,8 +37,8 @@ def test_importing_every_gpu_kernels_module_loads_no_blender_module():
     assert proc.returncode == 0, proc.stderr
     report = json.loads(proc.stdout.strip().splitlines()[-1])
     # The walk must really have imported the modules on disk (an empty walk would pass vacuously).
-    on_disk = {f[:-3] for f in os.listdir(CORE) if f.endswith(".py") and f != "__init__.py"}
-    imported = {m.rsplit(".", 1)[-1] for m in report["modules"][1:]}
+    on_disk = {f[:-3].replace(os.sep, ".").removesuffix(".__init__") for f in CORE_FILES if f != "__init__.py"}
+    imported = {m[len("bounce_gi.gpu_kernels."):] for m in report["modules"][1:]}
     assert on_disk <= imported, f"not imported: {sorted(on_disk - imported)}"
     assert report["blender"] == [], f"gpu_kernels pulled in Blender modules: {report['blender']}"
 
@@ -60,7 +63,7 @@ def test_import_line_parser_catches_what_it_must():
     assert {"bpy", "mathutils", "bmesh", "numpy", "os"} <= _imported_roots(text)
 
 
-@pytest.mark.parametrize("name", sorted(f for f in os.listdir(CORE) if f.endswith(".py")))
+@pytest.mark.parametrize("name", CORE_FILES)
 def test_gpu_kernels_source_never_imports_blender(name):
     with open(os.path.join(CORE, name), encoding="utf-8") as fh:
         text = fh.read()
