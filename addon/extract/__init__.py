@@ -29,7 +29,7 @@ def extract_scene(depsgraph, resolution=None) -> Scene:
     scene = depsgraph.scene_eval
     warnings: list[str] = []
     materials = MaterialTable(warnings)
-    geometry = Geometry(materials.index)
+    geometry = Geometry(materials.index, warnings)
     lights: list[Light] = []
     for inst in depsgraph.object_instances:
         obj = inst.object

@@ -75,13 +75,31 @@ def object_arrays(obj, material_index) -> dict | None:
     return arrays
 
 
-class Geometry:
-    """The world-space triangles of every instance added, in instance order."""
+def finite_normals(positions: np.ndarray, normals: np.ndarray) -> np.ndarray:
+    """`normals` with every non-finite or zero corner normal replaced by its triangle's geometric normal (a mesh
+    with broken custom normals still shades; the winding says which side is the front)."""
+    bad = ~np.isfinite(normals).all(axis=-1) | (np.abs(normals).sum(axis=-1) == 0)
+    if not bad.any():
+        return normals
+    p = positions.astype(np.float64)
+    geo = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    geo /= np.maximum(np.linalg.norm(geo, axis=-1, keepdims=True), 1e-30)
+    out = normals.copy()
+    out[bad] = np.broadcast_to(geo[:, None, :], normals.shape)[bad]
+    return out
 
-    def __init__(self, material_index):
+
+class Geometry:
+    """The world-space triangles of every instance added, in instance order. An instance with a NaN or infinite
+    vertex position (after its transform) is left out with a warning naming it: one broken object must not cost the
+    user the whole render."""
+
+    def __init__(self, material_index, warnings: list):
         self.material_index = material_index  # bpy material or None -> index in the Scene's materials
+        self.warnings = warnings
         self.chunks = {name: [] for name in ARRAYS}
         self.mesh_cache: dict = {}  # (object name, mesh name) -> local arrays, or None without triangles
+        self.skipped: set = set()  # objects already warned about
 
     def add_instance(self, obj, matrix: np.ndarray) -> None:
         mesh_key = (obj.name, obj.data.name if obj.data is not None else "")
@@ -91,8 +109,15 @@ class Geometry:
         if arrays is None:
             return
         pos, nrm, uvs = transform(arrays, matrix)
+        if not np.isfinite(pos).all():
+            if obj.name not in self.skipped:
+                self.skipped.add(obj.name)
+                bad = int((~np.isfinite(pos).all(axis=-1)).any(axis=-1).sum())
+                self.warnings.append(f"object '{obj.name}' has {bad} triangle(s) with a NaN or infinite vertex "
+                                     "position and is left out")
+            return
         self.chunks["positions"].append(pos)
-        self.chunks["normals"].append(nrm)
+        self.chunks["normals"].append(finite_normals(pos, nrm))
         self.chunks["uvs"].append(uvs)
         self.chunks["material_index"].append(arrays["material_index"])
 

@@ -46,6 +46,10 @@ def no_geometry():
     for ob in [o for o in bpy.data.objects if o.type == "MESH"]:
         bpy.data.objects.remove(ob)
 
+def nan_vertex():  # one broken vertex in one object (issue: it cost the user the whole render)
+    bpy.data.objects["TallBox"].data.vertices[0].co = (float("nan"), 0.0, 0.0)
+
+save_variant("nan_vertex.blend", nan_vertex)
 save_variant("no_camera.blend", no_camera)
 save_variant("no_lights.blend", no_lights)
 save_variant("no_geometry.blend", no_geometry, compress=True)  # also: a compressed .blend is accepted
@@ -215,6 +219,20 @@ def test_render_json_and_exr(env, blends, tmp_path):
     assert passes["Combined"][..., :3].mean() > 0, "the Cornell box renders black"
     assert sorted(os.listdir(tmp_path)) == ["cornell.exr"], "temporary files left behind"
     assert snapshot(blends) == before, "nothing written next to the .blend when --out is given"
+
+
+def test_a_nan_vertex_leaves_its_object_out_with_a_warning(env, blends, tmp_path):
+    """The object with a NaN vertex is skipped and named in a warning; the rest renders, every pass finite."""
+    from bounce_gi.gpu_kernels.output.exr import read_passes
+
+    whole = json.loads(run(env, "render", blends / "cornell.blend", "--res", 32, 24, "--out", tmp_path / "a.exr",
+                           "--json").stdout.strip().splitlines()[-1])
+    proc = run(env, "render", blends / "nan_vertex.blend", "--res", 32, 24, "--out", tmp_path / "b.exr", "--json")
+    assert proc.returncode == 0 and "Traceback" not in proc.stderr, describe(proc)
+    report = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert any("'TallBox'" in w and "NaN" in w for w in report["warnings"]), report["warnings"]
+    assert report["scene"]["triangles"] == whole["scene"]["triangles"] - 12  # the tall box's 6 quads
+    assert all(np.isfinite(image).all() for image in read_passes(str(tmp_path / "b.exr")).values())
 
 
 def test_render_default_output_and_text_report(env, blends, tmp_path):
