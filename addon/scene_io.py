@@ -106,8 +106,10 @@ def load_scene(path: str, resolution=None):
         scene = extract_scene(bpy.context.evaluated_depsgraph_get(), resolution)
     except ExtractError as exc:
         raise CliError(f"{path}: {exc}") from None
-    if not scene.lights and not scene.has_emission():
-        raise CliError(f"{path}: the scene has no lights and no emissive materials, so it would render black")
+    if not scene.lights and not scene.has_emission() and max(scene.world.color[:3]) <= 0:
+        # The world is a light too: a room lit by its sky alone renders (as in Cycles).
+        raise CliError(f"{path}: the scene has no lights and no emissive materials and its world is black, so it "
+                       "would render black")
     if scene.triangle_count == 0:
         raise CliError(f"{path}: the scene has no visible geometry")
     return scene

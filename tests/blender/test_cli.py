@@ -49,7 +49,18 @@ def no_geometry():
 def nan_vertex():  # one broken vertex in one object (issue: it cost the user the whole render)
     bpy.data.objects["TallBox"].data.vertices[0].co = (float("nan"), 0.0, 0.0)
 
+def sky_only():  # no lamp, no emission: the world (a constant sky) is the only light
+    no_lights()
+    world = bpy.data.worlds.new("Sky")
+    bpy.context.scene.world = world
+    if world.node_tree is None:
+        world.use_nodes = True
+    background = next(n for n in world.node_tree.nodes if n.bl_idname == "ShaderNodeBackground")
+    background.inputs["Color"].default_value = (0.5, 0.6, 0.8, 1.0)
+    background.inputs["Strength"].default_value = 1.0
+
 save_variant("nan_vertex.blend", nan_vertex)
+save_variant("sky_only.blend", sky_only)
 save_variant("no_camera.blend", no_camera)
 save_variant("no_lights.blend", no_lights)
 save_variant("no_geometry.blend", no_geometry, compress=True)  # also: a compressed .blend is accepted
@@ -233,6 +244,20 @@ def test_a_nan_vertex_leaves_its_object_out_with_a_warning(env, blends, tmp_path
     assert any("'TallBox'" in w and "NaN" in w for w in report["warnings"]), report["warnings"]
     assert report["scene"]["triangles"] == whole["scene"]["triangles"] - 12  # the tall box's 6 quads
     assert all(np.isfinite(image).all() for image in read_passes(str(tmp_path / "b.exr")).values())
+
+
+def test_a_scene_lit_by_its_sky_alone_renders(env, blends, tmp_path):
+    """No lamp, no emission, a blue world: the world is the light (it was refused as 'would render black')."""
+    from bounce_gi.gpu_kernels.output.exr import read_passes
+
+    proc = run(env, "render", blends / "sky_only.blend", "--method", "lpv", "--res", 32, 24, "--out",
+               tmp_path / "sky.exr", "--json")
+    assert proc.returncode == 0 and "Traceback" not in proc.stderr, describe(proc)
+    report = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert report["scene"]["lights"] == {"SUN": 0, "POINT": 0, "SPOT": 0, "AREA": 0}
+    passes = read_passes(str(tmp_path / "sky.exr"))
+    hit = passes["Depth"][..., 0] < 1e9
+    assert hit.any() and passes["Diffuse Indirect"][hit].mean() > 0, "the sky lights no surface"
 
 
 def test_render_default_output_and_text_report(env, blends, tmp_path):
