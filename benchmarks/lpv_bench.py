@@ -17,7 +17,7 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
-# Both transports (gpu_kernels/lpv_gather.py): the gather at its defaults (8 bounces, 4 gathered), the propagation
+# Both transports (gpu_kernels/lpv/gather.py): the gather at its defaults (8 bounces, 4 gathered), the propagation
 # at 3 bounces as it was measured before the gather existed.
 CONFIGS = [dict(transport=t, resolution=n, cascades=c, **({} if t == "gather" else {"bounces": 3}))
            for t in ("gather", "propagate") for n in (32, 64) for c in (1, 3)]

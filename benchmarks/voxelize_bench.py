@@ -58,7 +58,7 @@ def meshes(names):
 
 
 def trimesh_occupancy(mesh, grid):
-    """trimesh's surface voxels on our lattice (see tests/test_voxelize.py: voxel k is centred on k·pitch)."""
+    """trimesh's surface voxels on our lattice (see tests/gpu/test_voxelize.py: voxel k is centred on k·pitch)."""
     shifted = mesh.copy()
     shifted.apply_translation(-(np.asarray(grid.origin) + 0.5 * grid.cell))
     idx = np.round(shifted.voxelized(grid.cell).points / grid.cell).astype(int)

@@ -4,7 +4,7 @@
 160×120, 32³ grid, Cycles 128 spp × 2 seeds. Two comparisons on each typical interior, as the issue asks: with
 full bounces (8 on both sides) and with the same single bounce on both sides; for both transports.
 
-The gathered transport (default, gpu_kernels/lpv_gather.py) meets the issue's targets (Diffuse Indirect ≤ 25%,
+The gathered transport (default, gpu_kernels/lpv/gather.py) meets the issue's targets (Diffuse Indirect ≤ 25%,
 Combined ≤ 10% against full-bounce Cycles): against 2048-spp references (noise floor DI 0.025 / 0.018 / 0.031)
 it measures 0.071 / 0.040, 0.088 / 0.034, 0.069 / 0.051 (Cornell, spot room, courtyard). Against the 128-spp
 references held here the numbers below are higher by the references' own noise (DI noise floor ~0.07; the

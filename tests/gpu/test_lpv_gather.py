@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""The LPV's gathered transport (gpu_kernels/lpv_gather.py, the default): VPLs → surface voxels with fuzzy
+"""The LPV's gathered transport (gpu_kernels/lpv/gather.py, the default): VPLs → surface voxels with fuzzy
 visibility, bounce by bounce, with the extrapolated tail. Exact oracles: the closed sphere's bounce series, a lit
 patch's view factor, a closed partition; and the clustering's flux bookkeeping.
 """

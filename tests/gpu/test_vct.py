@@ -330,7 +330,7 @@ def test_defaults_are_valid_and_keys_separate_passes():
     assert VctSettings(diffuse_cones=19).key("bounce") == s.key("bounce")
     assert VctSettings(diffuse_cones=19).key("trace") != s.key("trace")
     assert VctSettings(diffuse_cones=19, bounce_cones=0).key("bounce") != VctSettings(bounce_cones=0).key("bounce")
-    assert s.specular_cone  # on by default: pixels with no glossy closure skip it (vct_specular.py)
+    assert s.specular_cone  # on by default: pixels with no glossy closure skip it (vct/specular.py)
     for change in (dict(indirect_scale=2), dict(temporal_frames=4), dict(cone_rotation=10.0), dict(subrays=5)):
         assert VctSettings(**change).key("trace") != s.key("trace") and VctSettings(**change).key("specular") == \
             s.key("specular") and VctSettings(**change).key("bounce") == s.key("bounce")

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""Temporal accumulation of the VCT diffuse gather (vct_temporal.py): repeated renders of an unchanged scene each
+"""Temporal accumulation of the VCT diffuse gather (gpu_kernels/vct/temporal.py): repeated renders of an unchanged scene each
 add one frame with the cone set turned about the normal; the history is the mean of the frames; any change of the
 trace's inputs restarts it (no ghost of the old scene)."""
 import dataclasses
