@@ -8,7 +8,8 @@ from concurrent.futures import Future
 from .gl.context import GpuWorker
 from .pipeline import Pipeline, RenderResult
 from .scene import Scene
-from .settings import RenderSettings, check_renderable
+from .settings import RenderSettings, check_method, check_renderable
+from .surface.atlas import build_atlas
 
 _engine = None
 _lock = threading.Lock()
@@ -24,6 +25,13 @@ class Engine:
         check_renderable(scene, settings)  # fail fast, on the caller's thread, for bad input
         return self.worker.submit(self._render, scene, settings)
 
+    def submit_surface(self, scene: Scene, settings: RenderSettings, budget: int) -> Future:
+        """Queue the view-independent lighting of `scene` on a surface atlas of at most `budget` texels per page
+        (pipeline.render_surface); the Future resolves to a SurfaceLight. The atlas is laid out on the worker
+        thread too, so the caller (Blender's main thread) never waits for it."""
+        check_method(settings)
+        return self.worker.submit(self._render_surface, scene, settings, int(budget))
+
     def render(self, scene: Scene, settings: RenderSettings) -> RenderResult:
         return self.submit_render(scene, settings).result()
 
@@ -31,6 +39,11 @@ class Engine:
         if self._pipeline is None:
             self._pipeline = Pipeline(ctx)
         return self._pipeline.render(scene, settings)
+
+    def _render_surface(self, ctx, scene, settings, budget):
+        if self._pipeline is None:
+            self._pipeline = Pipeline(ctx)
+        return self._pipeline.render_surface(scene, settings, build_atlas(scene, budget))
 
     @property
     def pipeline(self) -> Pipeline | None:

@@ -10,12 +10,17 @@ Passes and their inputs (a pass re-runs only when one of its inputs changed — 
     <method>      ← the above (lpv/passes.py, vct/passes.py: the indirect light)
     compose       ← everything above, world      (CPU: passes as numpy, Combined)
 
+render_surface() runs the same passes on a surface atlas's G-buffer (surface/): the viewport's view-independent
+lighting.
+
 A GI method is one entry of METHOD_PASSES: a function that takes the FrameInputs and returns a MethodOutput.
 """
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
+
+import numpy as np
 
 from .compose import compose_passes
 from .direct import gbuffer as gb
@@ -26,7 +31,10 @@ from .gl.pass_cache import PassCache
 from .gl.programs import ProgramCache
 from .lpv import passes as lpv_passes
 from .scene import Scene, hash_parts
-from .settings import METHODS, RenderSettings, check_renderable
+from .settings import METHODS, RenderSettings, check_method, check_renderable
+from .surface import gbuffer as sgb
+from .surface.atlas import SurfaceAtlas
+from .surface.mesh import draw_arrays
 from .vct import passes as vct_passes
 
 
@@ -40,6 +48,22 @@ class RenderResult:
     method: str
     resolution: tuple
     info: dict = field(default_factory=dict)  # method details: LPV iterations, injected flux, grids
+
+
+@dataclass
+class SurfaceLight:
+    """render_surface's result: the atlas and, per texel of both pages, (2H, W, 3) float32, rows bottom-up."""
+    atlas: SurfaceAtlas
+    direct: np.ndarray  # Diffuse Direct (irradiance / π)
+    indirect: np.ndarray  # Diffuse Indirect (zeros for method "none")
+    base: np.ndarray  # (H, W, 3): the front page's base colours (surface/gbuffer.base_colors)
+    mesh: dict  # the viewport's vertex arrays (surface/mesh.draw_arrays)
+    timings: dict
+    skipped: list
+    warnings: list
+    method: str
+    statistics: dict = field(default_factory=dict)  # Scene.statistics(): triangles, lights by type, bounds
+    info: dict = field(default_factory=dict)  # the method's details, as RenderResult.info (grids, bounces)
 
 
 @dataclass
@@ -95,12 +119,40 @@ class Pipeline:
                             statistics=scene.statistics(), method=settings.method,
                             resolution=(settings.width, settings.height), info=out.info if out else {})
 
-    def _direct_passes(self, scene: Scene, settings: RenderSettings) -> FrameInputs:
-        """The passes every method shares, up to the G-buffer and the shadow maps, and the keys they ran under."""
+    def render_surface(self, scene: Scene, settings: RenderSettings, atlas: SurfaceAtlas) -> SurfaceLight:
+        """Diffuse Direct and Diffuse Indirect at every texel of a surface atlas (surface/atlas.py): the same passes
+        as render(), on the atlas's G-buffer instead of the camera's. View-independent, so the viewport draws it
+        from any camera. Per-pixel refinements that need a camera are off: VCT's upsampling (its neighbours
+        would be other triangles' texels) and temporal accumulation."""
+        check_method(settings)  # no camera needed: the viewport has its own
+        start = time.perf_counter()
+        vct = replace(settings.vct, indirect_scale=1, temporal_frames=0, specular_cone=False)
+        settings = replace(settings, vct=vct)
+        self.cache.begin_frame()
+        frame = self._direct_passes(scene, settings, atlas)
+        direct_tex = self.cache.run("direct_light", frame.keys["direct"], lambda: lighting.render_direct_light(
+            self.ctx, self.programs, frame.gbuffer, frame.shadows))
+        method = METHOD_PASSES.get(settings.method)
+        out = method(frame) if method else None
+        gl_rows = slice(None, None, -1)  # read_texture gives image order; the atlas keeps GL's
+        direct = read_texture(direct_tex, 3)[gl_rows]
+        indirect = np.zeros_like(direct) if out is None or out.indirect is None else \
+            read_texture(out.indirect, 3)[gl_rows]
+        base = sgb.base_colors(scene, atlas, sgb.surface_points(scene, atlas))
+        timings = dict(self.cache.timings)
+        timings["total"] = time.perf_counter() - start
+        return SurfaceLight(atlas, direct, indirect, base, draw_arrays(scene, atlas), timings,
+                            list(self.cache.skipped), list(scene.warnings) + list(frame.shadows.warnings),
+                            settings.method, scene.statistics(), out.info if out else {})
+
+    def _direct_passes(self, scene: Scene, settings: RenderSettings, atlas: SurfaceAtlas | None = None) -> FrameInputs:
+        """The passes every method shares, up to the G-buffer and the shadow maps, and the keys they ran under.
+        The G-buffer is the camera's, or with `atlas` the surface atlas's (render_surface)."""
         ctx, programs, cache = self.ctx, self.programs, self.cache
         keys = {"geometry": hash_parts(scene.positions, scene.normals, scene.uvs, scene.material_index),
                 "materials": hash_parts(scene.materials, scene.textures), "lights": hash_parts(scene.lights),
-                "camera": hash_parts(scene.camera, scene.pixel_aspect, settings.width, settings.height),
+                "camera": hash_parts(scene.camera, scene.pixel_aspect, settings.width, settings.height)
+                if atlas is None else ("atlas", atlas.key),
                 "world": hash_parts(scene.world)}
         geometry = cache.run("geometry", (keys["geometry"],), lambda: geo.upload_geometry(ctx, programs, scene))
         textures = cache.run("textures", (keys["materials"],), lambda: geo.upload_textures(ctx, scene))
@@ -108,8 +160,12 @@ class Pipeline:
         shadows = cache.run("shadow_maps", keys["shadow"],
                             lambda: sh.render_shadow_atlas(ctx, programs, scene, geometry, settings.shadow))
         keys["gbuffer"] = (keys["geometry"], keys["materials"], keys["camera"])
-        gbuffer = cache.run("gbuffer", keys["gbuffer"], lambda: gb.render_gbuffer(
-            ctx, programs, scene, geometry, textures, settings.width, settings.height))
+        if atlas is None:
+            gbuffer = cache.run("gbuffer", keys["gbuffer"], lambda: gb.render_gbuffer(
+                ctx, programs, scene, geometry, textures, settings.width, settings.height))
+        else:
+            gbuffer = cache.run("gbuffer", keys["gbuffer"], lambda: sgb.upload_gbuffer(
+                ctx, sgb.gbuffer_arrays(sgb.surface_points(scene, atlas))))
         keys["direct"] = (keys["gbuffer"], keys["shadow"])
         return FrameInputs(ctx, programs, cache, scene, settings, geometry, textures, shadows, gbuffer, keys)
 

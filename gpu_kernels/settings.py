@@ -30,9 +30,14 @@ class RenderSettings:
         return repr(sorted(asdict(self).items()))
 
 
-def check_renderable(scene: Scene, settings: RenderSettings) -> None:
+def check_method(settings: RenderSettings) -> None:
     if settings.method not in METHODS:
         raise SceneError(f"unknown method '{settings.method}' (choose from {', '.join(METHODS)})")
+
+
+def check_renderable(scene: Scene, settings: RenderSettings) -> None:
+    """A render from the scene camera: a known method, a camera, a sane resolution."""
+    check_method(settings)
     if scene.camera is None:
         raise SceneError("the scene has no camera")
     if settings.width < 1 or settings.height < 1 or settings.width > 16384 or settings.height > 16384:

@@ -12,7 +12,7 @@ from support.import_graph import FILES, GRAPH, MODULES, PACKAGE, PRIVATE, ROOT, 
 
 # Inside the core, a module may import from its own package or from a lower rank: gl → common → direct → voxel →
 # lpv | vct → settings, compose → pipeline → engine (scene and output are plain data and I/O, rank 0).
-CORE_RANK = {"gl": 0, "scene": 0, "output": 0, "common": 1, "direct": 2, "voxel": 3, "lpv": 4, "vct": 4,
+CORE_RANK = {"gl": 0, "scene": 0, "output": 0, "common": 1, "direct": 2, "voxel": 3, "surface": 3, "lpv": 4, "vct": 4,
              "settings": 5, "compose": 5, "pipeline": 6, "engine": 7}
 TOOLING = ("bounce_gi.addon.cli", "bounce_gi.addon.bench", "bounce_gi.addon.scene_io")  # left out of the zip
 MAX_MODULE_LINES = 400
@@ -57,7 +57,9 @@ def test_addon_and_ui_import_in_one_direction():
     wrong = []
     for name, edges in GRAPH.items():
         for target in edges:
-            if name.startswith(f"{PACKAGE}.addon") and target.startswith(f"{PACKAGE}.ui"):
+            # The tooling sits above everything: `bounce-gi snapshot` draws with the UI's own drawing path.
+            if name.startswith(f"{PACKAGE}.addon") and not name.startswith(TOOLING) \
+                    and target.startswith(f"{PACKAGE}.ui"):
                 wrong.append(f"{name} → {target}")
             shipped = name.startswith((f"{PACKAGE}.addon", f"{PACKAGE}.ui")) and not name.startswith(TOOLING)
             if shipped and target.startswith(TOOLING):
