@@ -8,7 +8,7 @@ Panels only read state; everything they show about the last render comes from
 import bpy
 from bpy.types import Panel
 
-from . import preview
+from . import overlay, preview, viewport
 
 
 def _format_seconds(seconds: float) -> str:
@@ -24,9 +24,13 @@ def draw_render_settings(layout, settings) -> None:
     layout.prop(settings, "use_time_budget")
     if settings.use_time_budget:
         layout.prop(settings, "time_budget_ms")
-    row = layout.row()
-    row.enabled = not settings.use_time_budget  # the budget picks the method
-    row.prop(settings, "method")
+    col = layout.column()
+    col.enabled = not settings.use_time_budget  # the budget picks method and settings
+    col.prop(settings, "method")
+    col.prop(settings, "quality")
+    if settings.method in ("LPV", "VCT"):  # advanced: overrides of the quality's settings
+        col.prop(settings, "bounces")
+        col.prop(settings, "grid_resolution")
 
 
 class VIEW3D_PT_bounce_gi(Panel):
@@ -54,6 +58,47 @@ class VIEW3D_PT_bounce_gi(Panel):
             row.operator("bounce_gi.render_preview", icon="RENDER_STILL")
         if preview.state.last_error:
             layout.label(text=preview.state.last_error, icon="ERROR")
+        row = layout.row(align=True)
+        row.operator("bounce_gi.toggle_overlay", text="GI Overlay", icon="OVERLAY", depress=overlay.is_on())
+        row.prop(settings, "display_mode", text="")
+
+
+class VIEW3D_PT_bounce_gi_viewport(Panel):
+    """The live viewport GI (Rendered shading or the overlay): the stage on screen, latency, cost, atlas."""
+
+    bl_space_type = "VIEW_3D"
+    bl_region_type = "UI"
+    bl_category = "Bounce GI"
+    bl_label = "Viewport GI"
+    bl_parent_id = "VIEW3D_PT_bounce_gi"
+
+    @classmethod
+    def poll(cls, context):
+        return viewport.newest_feed() is not None
+
+    def draw(self, context):
+        feed = viewport.newest_feed()
+        s = feed.session.stats
+        layout = self.layout
+        layout.label(text=feed.status().removeprefix("Bounce GI: "), icon="ERROR" if s.error else "SHADING_RENDERED")
+        if s.changed:
+            layout.label(text=f"Last edit: {s.changed}")
+        col = layout.column(align=True)
+        rows = [(f"Edit → {stage}", seconds) for stage, seconds in s.latency.items()]
+        rows += [(f"Main thread: {part}", seconds) for part, seconds in s.main_thread.items()]
+        rows += [(name, seconds) for name, seconds in s.timings.items()]
+        for name, seconds in rows:
+            split = col.split(factor=0.6)
+            split.label(text=name)
+            split.label(text="cached" if name in s.skipped else _format_seconds(seconds))
+        if s.texels:
+            layout.label(text=f"{s.triangles} triangles, {s.texels} texels of {s.texel_size * 100:.1f} cm")
+            lights = ", ".join(f"{n} {kind.lower()}" for kind, n in s.lights.items()) or "none"
+            layout.label(text=f"Lights: {lights}")
+        if s.grid:
+            layout.label(text=f"Grid: {s.grid}")
+        for text in s.warnings:
+            layout.label(text=text, icon="ERROR")
 
 
 class VIEW3D_PT_bounce_gi_last_render(Panel):
@@ -117,9 +162,10 @@ class RENDER_PT_bounce_gi(Panel):
 
     def draw(self, context):
         draw_render_settings(self.layout, context.scene.bounce_gi)
+        self.layout.prop(context.scene.bounce_gi, "display_mode")
 
 
-classes = (VIEW3D_PT_bounce_gi, VIEW3D_PT_bounce_gi_last_render, RENDER_PT_bounce_gi)
+classes = (VIEW3D_PT_bounce_gi, VIEW3D_PT_bounce_gi_viewport, VIEW3D_PT_bounce_gi_last_render, RENDER_PT_bounce_gi)
 
 
 def register():

@@ -10,6 +10,8 @@ from bpy.types import PropertyGroup
 
 # Identifiers are upper case (Blender convention); the engine wants lower case (method_id()).
 METHOD_ITEMS = (
+    ("AUTO", "Auto", "The fastest measured setting (addon/quality_front.json) that reaches the chosen quality's "
+                     "error against Cycles"),
     ("NONE", "Direct only", "Direct light with shadow maps, no indirect bounce"),
     ("LPV", "Light Propagation Volumes", "Indirect light propagated through a grid of SH coefficients"),
     ("VCT", "Voxel Cone Tracing", "Indirect light gathered by tracing cones through a voxel mip chain"),
@@ -20,6 +22,14 @@ METHOD_ITEMS = (
 PATH_OPTIONS = {"ANIMATABLE", "PATH_SUPPORTS_BLEND_RELATIVE"} if bpy.app.version >= (4, 5, 0) else {"ANIMATABLE"}
 
 
+def redraw_views(_self, context) -> None:
+    """A display change needs no GI update, only a redraw of every 3D view."""
+    for window in getattr(context.window_manager, "windows", ()):
+        for area in window.screen.areas:
+            if area.type == "VIEW_3D":
+                area.tag_redraw()
+
+
 class BounceGISettings(PropertyGroup):
     """What the Render Preview operator renders, and where it writes the render passes."""
 
@@ -27,9 +37,26 @@ class BounceGISettings(PropertyGroup):
         name="Method",
         description="How indirect (bounced) light is computed",
         items=METHOD_ITEMS,
-        # VCT: the most accurate against Cycles (benchmarks/results/llvmpipe/summary.md); the preview runs off the UI
-        # thread, so its cost on a slow GPU delays the image, not the interface.
-        default="VCT",
+        # Auto: a setting measured to be fast for its error, rather than one method's most expensive defaults (a
+        # furnished room took minutes at VCT's defaults on a software GL).
+        default="AUTO",
+    )
+    quality: EnumProperty(
+        name="Quality",
+        description="With Auto: the error to reach; with a method: its settings (Medium: the method's defaults)",
+        items=[("DRAFT", "Draft", "Fast: coarser grids, fewer cones"), ("MEDIUM", "Medium", "The defaults"),
+               ("HIGH", "High", "More accurate, slower")],
+        default="MEDIUM",
+    )
+    bounces: IntProperty(
+        name="Bounces",
+        description="Indirect bounces (LPV and VCT; 0: the quality's, 8 like Cycles' default)",
+        min=0, max=8, default=0,
+    )
+    grid_resolution: IntProperty(
+        name="Grid",
+        description="Grid cells along the scene's longest axis (LPV 4..256, VCT 16..512; 0: the quality's)",
+        min=0, max=512, default=0,
     )
     use_time_budget: BoolProperty(
         name="Time Budget",
@@ -62,8 +89,19 @@ class BounceGISettings(PropertyGroup):
         default="",
     )
 
+    display_mode: EnumProperty(
+        name="Display",
+        description="What Rendered shading and the overlay draw",
+        items=[("COMBINED", "Combined", "Direct and indirect light, times the surface colour, plus emission"),
+               ("INDIRECT", "Indirect Only", "Only the bounced light (Diffuse Indirect × colour)"),
+               ("DIRECT", "Direct Only", "Only the direct light and emission")],
+        default="COMBINED",
+        update=redraw_views,
+    )
+
     def method_id(self) -> str:
-        """The method as the engine's RenderSettings spells it ("none" | "lpv" | "vct")."""
+        """The method as the engine's RenderSettings spells it ("auto" | "none" | "lpv" | "vct"; "auto" is resolved
+        by preview.render_settings_of, never sent to the engine)."""
         return self.method.lower()
 
 

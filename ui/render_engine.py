@@ -9,8 +9,11 @@ Cycles name. The result is begun only once every pass is in hand, so a failure n
 is one ERROR report and an empty result. With Render Region (`use_border`) the full frame is rendered and the
 region copied out (Blender then crops or places it, as for any engine). One render per view layer, mono only.
 
-Not here yet: viewport rendering (view_update / view_draw). Material Preview shading uses EEVEE
-(`bl_use_eevee_viewport`).
+Rendered shading: `view_update` hands the depsgraph's updates to a viewport.ViewportFeed (extract what the GI
+depends on, queue one job on the GPU thread, never wait); `view_draw` draws the newest finished result from the
+3D view's camera with draw.SurfaceDrawing into an offscreen buffer, then shows it through Blender's display-space
+shader (the view transform, as for any engine's image). Orbiting redraws; it re-runs no GI pass. Material Preview
+shading uses EEVEE (`bl_use_eevee_viewport`).
 """
 import concurrent.futures
 import traceback
@@ -71,7 +74,60 @@ class BounceGIRenderEngine(bpy.types.RenderEngine):
     bl_label = "Bounce GI"
     bl_use_preview = False  # material and light thumbnails stay with EEVEE
     bl_use_shading_nodes_custom = False  # Blender's shader nodes: extraction reads Principled, Diffuse, Emission
-    bl_use_eevee_viewport = True  # Material Preview shading with EEVEE (our own viewport drawing comes later)
+    bl_use_eevee_viewport = True  # Material Preview shading with EEVEE; Rendered shading is ours
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)  # Blender passes the engine's RNA pointer
+        self.feed = None  # viewport.ViewportFeed, made by the first view_update
+        self.offscreen = None
+
+    def __del__(self):
+        try:
+            self.free_viewport()
+        except (ReferenceError, AttributeError):  # Blender already freed the RNA struct
+            pass
+
+    def free_viewport(self) -> None:
+        if getattr(self, "feed", None) is not None:
+            self.feed.close()
+            self.feed = None
+        if getattr(self, "offscreen", None) is not None:
+            self.offscreen.free()
+            self.offscreen = None
+
+    def view_update(self, context, depsgraph):
+        from .viewport import ViewportFeed
+
+        first = self.feed is None
+        if first:
+            self.feed = ViewportFeed(on_update=self.tag_redraw)
+        self.feed.update(depsgraph, first=first)
+
+    def view_draw(self, context, depsgraph):
+        import gpu
+        from gpu_extras.presets import draw_texture_2d
+
+        from . import draw
+        from .viewport import region_view
+
+        region = context.region
+        width, height = region.width, region.height
+        if self.offscreen is None or (self.offscreen.width, self.offscreen.height) != (width, height):
+            if self.offscreen is not None:
+                self.offscreen.free()
+            self.offscreen = gpu.types.GPUOffScreen(width, height, format="RGBA16F")
+        feed = self.feed
+        drawing = feed.session.drawing if feed is not None else None
+        background = feed.world_color if feed is not None else (0.0, 0.0, 0.0)
+        mode = depsgraph.scene.bounce_gi.display_mode
+        draw.draw_offscreen(drawing, self.offscreen, region_view(context.region_data), background, mode)
+        gpu.state.blend_set("ALPHA_PREMULT")
+        self.bind_display_space_shader(depsgraph.scene)
+        draw_texture_2d(self.offscreen.texture_color, (0, 0), width, height)
+        self.unbind_display_space_shader()
+        gpu.state.blend_set("NONE")
+        if feed is not None:
+            self.update_stats("", feed.status())
 
     def update_render_passes(self, scene=None, renderlayer=None):
         for name, channels, letters, kind in PASSES:

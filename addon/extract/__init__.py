@@ -24,8 +24,9 @@ from .world import read_world
 __all__ = ["ExtractError", "extract_scene"]
 
 
-def extract_scene(depsgraph, resolution=None) -> Scene:
-    """Build a Scene from an evaluated depsgraph. `resolution` overrides the scene's render size (W, H)."""
+def extract_scene(depsgraph, resolution=None, require_camera: bool = True) -> Scene:
+    """Build a Scene from an evaluated depsgraph. `resolution` overrides the scene's render size (W, H). Without
+    `require_camera` (the viewport draws from its own view) a scene with no usable camera gets camera None."""
     scene = depsgraph.scene_eval
     warnings: list[str] = []
     materials = MaterialTable(warnings)
@@ -44,6 +45,16 @@ def extract_scene(depsgraph, resolution=None) -> Scene:
             geometry.add_instance(obj, matrix)
     render = scene.render
     return Scene(**geometry.arrays(), materials=materials.materials, textures=materials.textures, lights=lights,
-                 world=read_world(scene, warnings), camera=read_camera(scene),
+                 world=read_world(scene, warnings), camera=camera_of(scene, require_camera),
                  resolution=render_resolution(render, resolution), pixel_aspect=pixel_aspect(render),
                  warnings=warnings)
+
+
+def camera_of(scene, required: bool):
+    """read_camera, or None when the camera is optional and missing or unsupported."""
+    try:
+        return read_camera(scene)
+    except ExtractError:
+        if required:
+            raise
+        return None

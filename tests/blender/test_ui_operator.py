@@ -71,29 +71,32 @@ def test_write_preview_image_orientation_and_reuse(tmp_path):
     """)
 
 
+# No UI in background mode, so draw() gets a recording layout that checks every property, operator and icon name
+# against Blender's RNA (typos there only show up as console errors); `seen` records what was drawn.
+RECORDING_LAYOUT = """
+from types import SimpleNamespace
+from bounce_gi.ui import panel
+icons = set(bpy.types.UILayout.bl_rna.functions["label"].parameters["icon"].enum_items.keys())
+seen = []
+
+class Layout:
+    def __getattr__(self, name):   # row(), column(), box(), split() ...
+        return lambda *a, **k: Layout()
+    def __setattr__(self, name, value):
+        pass
+    def prop(self, data, name, **k):
+        assert name in data.bl_rna.properties, name; seen.append(("prop", name))
+    def operator(self, idname, **k):
+        mod, op = idname.split(".")
+        getattr(getattr(bpy.ops, mod), op).get_rna_type(); seen.append(("op", idname))
+        assert k.get("icon", "NONE") in icons, k
+    def label(self, text="", icon="NONE", **k):
+        assert icon in icons, icon; seen.append(("label", text))
+"""
+
+
 def test_panels_draw_with_valid_names(tmp_path):
-    # No UI in background mode, so draw() gets a recording layout that checks every property,
-    # operator and icon name against Blender's RNA (typos there only show up as console errors).
-    run_case(tmp_path, """
-        from types import SimpleNamespace
-        from bounce_gi.ui import panel
-        icons = set(bpy.types.UILayout.bl_rna.functions["label"].parameters["icon"].enum_items.keys())
-        seen = []
-
-        class Layout:
-            def __getattr__(self, name):   # row(), column(), box(), split() ...
-                return lambda *a, **k: Layout()
-            def __setattr__(self, name, value):
-                pass
-            def prop(self, data, name, **k):
-                assert name in data.bl_rna.properties, name; seen.append(("prop", name))
-            def operator(self, idname, **k):
-                mod, op = idname.split(".")
-                getattr(getattr(bpy.ops, mod), op).get_rna_type(); seen.append(("op", idname))
-                assert k.get("icon", "NONE") in icons, k
-            def label(self, text="", icon="NONE", **k):
-                assert icon in icons, icon; seen.append(("label", text))
-
+    run_case(tmp_path, RECORDING_LAYOUT + """
         ctx = SimpleNamespace(scene=bpy.context.scene)
         preview.state.last = preview.RenderReport("none", 32, 24, {"gbuffer": 0.002, "shadow_maps": 0.0,
                                                   "total": 0.01}, ["material 'X' fell back"], 0.5, ["shadow_maps"])
@@ -114,8 +117,15 @@ def test_panels_draw_with_valid_names(tmp_path):
         bpy.context.scene.bounce_gi.use_time_budget = True
         panel.RENDER_PT_bounce_gi.draw(SimpleNamespace(layout=Layout()), ctx)
         print("render properties", seen)
-        assert seen == [("prop", "use_time_budget"), ("prop", "time_budget_ms"), ("prop", "method")], seen
+        assert seen == [("prop", "use_time_budget"), ("prop", "time_budget_ms"), ("prop", "method"),
+                        ("prop", "quality"), ("prop", "display_mode")], seen
         bpy.context.scene.bounce_gi.use_time_budget = False
+        seen.clear()
+        bpy.context.scene.bounce_gi.method = "LPV"   # a method by hand: its advanced overrides show
+        panel.RENDER_PT_bounce_gi.draw(SimpleNamespace(layout=Layout()), ctx)
+        assert seen == [("prop", "use_time_budget"), ("prop", "method"), ("prop", "quality"), ("prop", "bounces"),
+                        ("prop", "grid_resolution"), ("prop", "display_mode")], seen
+
 
         # Opening another file forgets the last render (its times would describe another scene).
         bpy.ops.wm.read_homefile(use_empty=True)
@@ -269,4 +279,74 @@ def test_output_setting_writes_the_passes(tmp_path):
             else:
                 raise AssertionError(f"Output {{bad}} was accepted")
         assert not os.path.exists({str(tmp_path / "x.png")!r})
+    """)
+
+
+def test_the_viewport_panel_shows_the_live_stats(tmp_path):
+    run_case(tmp_path, RECORDING_LAYOUT + """
+        ctx = SimpleNamespace(scene=bpy.context.scene)
+        from bounce_gi.ui import viewport
+        assert not panel.VIEW3D_PT_bounce_gi_viewport.poll(ctx)
+        feed = viewport.ViewportFeed()
+        st = feed.session.stats
+        st.stage, st.running, st.latency = "draft", "final", {"direct": 0.1, "draft": 1.2}
+        st.main_thread, st.timings, st.skipped = {"extract": 0.004}, {"rsm": 0.1, "gbuffer": 0.0}, ["gbuffer"]
+        st.texels, st.triangles, st.lights, st.grid = 1000, 12, {"AREA": 1}, "32 x 32 x 32"
+        seen.clear()
+        assert panel.VIEW3D_PT_bounce_gi_viewport.poll(ctx)
+        panel.VIEW3D_PT_bounce_gi_viewport.draw(SimpleNamespace(layout=Layout()), ctx)
+        print("viewport panel", seen)
+        assert ("label", "draft GI (computing final)") in seen and ("label", "Edit → draft") in seen
+        assert ("label", "cached") in seen and ("label", "Lights: 1 area") in seen
+        assert ("label", "Grid: 32 x 32 x 32") in seen
+        feed.close()
+        assert not panel.VIEW3D_PT_bounce_gi_viewport.poll(ctx)
+    """)
+
+
+def test_the_live_session_keeps_one_job_and_replaces_the_queued_one(tmp_path):
+    # ui/live.py with a fake engine (Futures resolved by hand) and a fake upload: what is submitted, in which
+    # order, and what the stats say — the behaviour the viewport relies on, independent of any GPU.
+    run_case(tmp_path, """
+        from concurrent.futures import Future
+        from types import SimpleNamespace
+        from bounce_gi.ui import live
+        from bounce_gi.gpu_kernels.settings import RenderSettings
+
+        submitted = []
+        def submit(scene, settings, texels):
+            f = Future(); submitted.append((scene, settings.method, texels, f)); return f
+        drawings = []
+        def light():
+            return SimpleNamespace(atlas=SimpleNamespace(texel_count=10, texel=0.1), timings={"total": 0.1},
+                                   skipped=[], warnings=[], statistics={"lights": {"SUN": 1, "AREA": 0}},
+                                   info={"grid": [32, 32, 16]})
+        s = live.LiveSession(submit=submit, make_drawing=lambda l: drawings.append(l) or SimpleNamespace(
+            triangles=2, free=lambda: None))
+        lpv = RenderSettings("lpv", 8, 8)
+        assert [n for n, *_ in live.stages_for(lpv)] == ["direct", "draft", "final"]
+        assert [n for n, *_ in live.stages_for(RenderSettings("none", 8, 8))] == ["direct", "final"]
+        draft = live.stages_for(lpv)[1][1]
+        assert draft.lpv.resolution == 16 and live.stages_for(lpv)[2][1] == lpv
+
+        s.request("A", lpv)
+        s.request("B", lpv)
+        s.request("C", lpv)                      # B never starts: C replaced it
+        assert [x[:3] for x in submitted] == [("A", "none", 16384)] and s.queued[0] == "C"
+        assert s.poll() is not None              # A's first stage still running
+        submitted[0][3].set_result(light())
+        assert s.poll() is not None              # shown, and the queued C starts over (A's other stages dropped)
+        assert s.stats.stage == "direct" and len(drawings) == 1 and s.stats.lights == {"SUN": 1}
+        assert s.stats.grid == "32 x 32 x 16"
+        assert [x[:3] for x in submitted[1:]] == [("C", "none", 16384)]
+        for expected in (("C", "lpv", 16384), ("C", "lpv", 65536)):
+            submitted[-1][3].set_result(light())
+            s.poll()
+            assert submitted[-1][:3] == expected, submitted[-1][:3]
+        submitted[-1][3].set_exception(RuntimeError("boom"))
+        assert s.poll() is None and not s.busy
+        print(s.stats)
+        assert s.stats.error == "boom" and s.stats.stage == "draft" and list(s.stats.latency) == ["direct", "draft"]
+        s.close()
+        assert s.drawing is None and s.poll() is None
     """)

@@ -1,0 +1,52 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The viewport's surfaces, drawn with Blender's gpu module (ui/draw.py declares the inputs through
+// gpu.types.GPUShaderCreateInfo, so this file holds only the stages' bodies): light looked up in the surface atlas
+// (gpu_kernels/surface/), where the render's own passes computed Diffuse Direct and Diffuse Indirect per texel —
+// uploaded already multiplied by the texel's base colour — times the view-dependent diffuse share of the
+// material as the G-buffer computes it (common/principled.glsl), plus emission: Cycles' Combined without the
+// glossy part, from any camera, with no GI pass per view.
+//
+// Push constants: u_view_projection; u_eye (xyz camera position, w 1 if orthographic); u_forward (xyz unit view
+// axis, w the atlas page height in texels); u_params (x: 0 Combined, 1 indirect only, 2 direct only; y: depth
+// pulled toward the camera, in clip w — the overlay draws over Blender's own copy of the same surfaces).
+
+#if defined(VERTEX_SHADER)
+void main() {
+    v_position = pos;
+    v_normal = nrm;
+    v_geo_normal = geo;
+    v_tile = tile;
+    v_box = box;
+    v_mat = mat;
+    v_emission = emission;
+    gl_Position = u_view_projection * vec4(pos, 1.0);
+    gl_Position.z -= u_params.y * gl_Position.w;
+}
+#endif
+
+#if defined(FRAGMENT_SHADER)
+#include "common/principled.glsl"
+
+// Bilinear lookup at texel coordinate c (texel centres at +0.5): the textures are uploaded with linear filtering
+// (draw.rgba_texture), so one fetch.
+vec3 atlas_lookup(sampler2D atlas, vec2 c) {
+    return texture(atlas, c / vec2(textureSize(atlas, 0))).rgb;
+}
+
+void main() {
+    vec3 view_dir = u_eye.w > 0.5 ? -u_forward.xyz : normalize(u_eye.xyz - v_position);
+    vec3 n = normalize(v_normal);
+    // Two-sided as in Cycles: seen from behind, the surface is lit by the atlas's back page.
+    bool back = dot(v_geo_normal, view_dir) < 0.0;
+    if (back) n = -n;
+    // Stay on this triangle's texel centres: the 2×2 footprint never reaches a neighbouring tile.
+    vec2 c = clamp(v_tile, v_box.xy + 0.5, v_box.xy + vec2(v_box.z) - 0.5);
+    vec2 page = vec2(0.0, back ? u_forward.w : 0.0);
+    float share = (1.0 - v_mat.x) * (v_mat.z > 0.5 ? principled_diffuse_share(dot(n, view_dir), v_mat.y) : 1.0);
+    vec3 direct = share * atlas_lookup(u_direct, c + page);
+    vec3 indirect = share * atlas_lookup(u_indirect, c + page);
+    int mode = int(u_params.x + 0.5);
+    vec3 color = mode == 1 ? indirect : mode == 2 ? direct + v_emission : direct + indirect + v_emission;
+    out_color = vec4(color, 1.0);
+}
+#endif
