@@ -20,6 +20,9 @@ from .bench_command import cmd_bench
 from .compare import cmd_compare, compare, format_compare
 from .options import parse_method_options, render_ours, vct_options
 from .render import cmd_render, format_timings
+from .snapshot import cmd_snapshot
+
+SNAPSHOT_TEXELS = 65536  # the viewport's refined stage (ui/live.py STAGES)
 
 __all__ = ["main", "build_parser", "CliError", "check_blend_path", "load_scene", "compare", "format_compare",
            "format_timings", "parse_method_options", "render_ours", "vct_options"]
@@ -64,6 +67,18 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--lpv", nargs="+", metavar="KEY=VALUE", help="LPV settings, e.g. bounces=4 resolution=32")
     c.add_argument("--vct", nargs="+", metavar="KEY=VALUE", help="VCT settings, e.g. bounces=4 resolution=64")
     c.set_defaults(func=cmd_compare)
+    s = sub.add_parser("snapshot", help="draw the scene camera's view as the viewport does (EXR or PNG)")
+    s.add_argument("scene")
+    s.add_argument("--method", choices=METHODS, help="default: none")
+    s.add_argument("--res", nargs=2, type=int, metavar=("W", "H"))
+    s.add_argument("--out", required=True, help="output .exr (a Combined layer, scene-linear) or .png")
+    s.add_argument("--display", choices=("combined", "indirect", "direct"), default="combined")
+    s.add_argument("--texels", type=int, default=SNAPSHOT_TEXELS, metavar="N",
+                   help=f"surface atlas texels per page (default {SNAPSHOT_TEXELS})")
+    s.add_argument("--json", action="store_true", help="print one JSON object as the last stdout line")
+    s.add_argument("--lpv", nargs="+", metavar="KEY=VALUE", help="LPV settings, e.g. bounces=4 resolution=32")
+    s.add_argument("--vct", nargs="+", metavar="KEY=VALUE", help="VCT settings, e.g. bounces=4 resolution=64")
+    s.set_defaults(func=cmd_snapshot)
     b = sub.add_parser("bench", help="time vs error of our settings, Cycles (± OIDN) and EEVEE; plots, summary.md")
     b.add_argument("scenes", nargs="*", metavar="SCENE")
     b.add_argument("--quick", action="store_true", help="few settings, 96x72, 64-spp reference, one timed run")
@@ -86,6 +101,8 @@ def main(argv=None) -> int:
     try:
         if args.res and (args.res[0] < 1 or args.res[1] < 1):
             raise CliError("--res needs two positive integers")
+        if getattr(args, "texels", 1) < 1:
+            raise CliError("--texels must be at least 1")
         if getattr(args, "samples", 1) < 1:
             raise CliError("--samples must be at least 1")
         report = args.func(args)

@@ -39,11 +39,14 @@ def vct_options(pairs) -> dict:
     return parse_method_options(pairs, VctSettings, "--vct")
 
 
-def render_ours(scene, method: str, lpv_options: dict | None = None, vct_settings: dict | None = None):
-    from ...gpu_kernels.engine import get_engine
-    from ...gpu_kernels.gl.context import GpuUnavailableError
+def method_settings(scene, method: str, lpv_pairs=None, vct_pairs=None):
+    """RenderSettings at the scene's resolution from --method and the --lpv / --vct KEY=VALUE pairs."""
+    return settings_of(scene, method, parse_method_options(lpv_pairs), vct_options(vct_pairs))
+
+
+def settings_of(scene, method: str, lpv_options: dict | None, vct_settings: dict | None):
     from ...gpu_kernels.lpv.settings import LpvSettings
-    from ...gpu_kernels.settings import RenderSettings, SceneError
+    from ...gpu_kernels.settings import RenderSettings
     from ...gpu_kernels.vct.settings import VctSettings
 
     try:
@@ -51,8 +54,16 @@ def render_ours(scene, method: str, lpv_options: dict | None = None, vct_setting
         vct = VctSettings(**(vct_settings or {}))
     except ValueError as exc:
         raise CliError(f"method settings: {exc}") from None
-    settings = RenderSettings(method=method, width=scene.resolution[0], height=scene.resolution[1],
-                              lpv=lpv_settings, vct=vct)
+    return RenderSettings(method=method, width=scene.resolution[0], height=scene.resolution[1],
+                          lpv=lpv_settings, vct=vct)
+
+
+def render_ours(scene, method: str, lpv_options: dict | None = None, vct_settings: dict | None = None):
+    from ...gpu_kernels.engine import get_engine
+    from ...gpu_kernels.gl.context import GpuUnavailableError
+    from ...gpu_kernels.settings import SceneError
+
+    settings = settings_of(scene, method, lpv_options, vct_settings)
     try:
         return get_engine().render(scene, settings)
     except (SceneError, NotImplementedError, GpuUnavailableError) as exc:

@@ -163,6 +163,10 @@ ERROR_CASES = {
     "samples_zero": (lambda b, t: ["compare", b / "light_sun.blend", "--samples", 0], ["--samples"]),
     "heatmap_wrong_suffix": (lambda b, t: ["compare", b / "light_sun.blend", "--heatmap", t / "h.exr"], [".png"]),
     "compare_no_camera": (lambda b, t: ["compare", b / "no_camera.blend", "--res", 8, 6], ["no camera"]),
+    "snapshot_no_camera": (lambda b, t: ["snapshot", b / "no_camera.blend", "--out", t / "o.exr"], ["no camera"]),
+    "snapshot_wrong_suffix": (lambda b, t: ["snapshot", b / "cornell.blend", "--out", t / "o.jpg"], [".exr or .png"]),
+    "snapshot_texels_zero": (lambda b, t: ["snapshot", b / "cornell.blend", "--texels", 0, "--out", t / "o.png"],
+                             ["--texels"]),
 }
 
 
@@ -230,6 +234,30 @@ def test_render_json_and_exr(env, blends, tmp_path):
     assert passes["Combined"][..., :3].mean() > 0, "the Cornell box renders black"
     assert sorted(os.listdir(tmp_path)) == ["cornell.exr"], "temporary files left behind"
     assert snapshot(blends) == before, "nothing written next to the .blend when --out is given"
+
+
+def test_snapshot_draws_what_render_renders(env, blends, tmp_path):
+    # The viewport's drawing path (surface atlas + the gpu-module shader, ui/draw.py) against the render of the same
+    # scene: direct light only here, so the difference is the atlas's texels against pixels — at 64 × 48 a pixel
+    # spans a few texels of the Cornell walls (shadow edges and corners are where they differ). Measured 0.0100
+    # rel-L1. Both sides are deterministic, so the margin is only for the texel size (a bisection) landing a
+    # rounding step elsewhere on another machine: 0.012.
+    from bounce_gi.gpu_kernels.output.exr import read_passes
+
+    exr, png, rendered = tmp_path / "shot.exr", tmp_path / "shot.png", tmp_path / "render.exr"
+    proc = run(env, "snapshot", blends / "cornell.blend", "--res", 64, 48, "--out", exr, "--json")
+    assert proc.returncode == 0, describe(proc)
+    report = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert report["resolution"] == [64, 48] and 0 < report["texels"] <= 65536 and report["method"] == "none"
+    assert run(env, "render", blends / "cornell.blend", "--res", 64, 48, "--out", rendered).returncode == 0
+    shot, want = read_passes(str(exr)), read_passes(str(rendered))["Combined"][..., :3]
+    assert list(shot) == ["Combined"]
+    rel = float(np.abs(shot["Combined"][..., :3] - want).sum() / np.abs(want).sum())
+    print("snapshot vs render rel-L1", rel)
+    assert rel < 0.012
+    proc = run(env, "snapshot", blends / "cornell.blend", "--res", 64, 48, "--out", png)
+    assert proc.returncode == 0 and png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n", describe(proc)
+    assert sorted(os.listdir(tmp_path)) == ["render.exr", "shot.exr", "shot.png"], "temporary files left behind"
 
 
 def test_a_nan_vertex_leaves_its_object_out_with_a_warning(env, blends, tmp_path):
