@@ -102,3 +102,38 @@ def render_settings_for(choice: Choice, width: int, height: int):
     kwargs = {"lpv": build(LpvSettings)} if choice.method == "lpv" else \
         {"vct": build(VctSettings)} if choice.method == "vct" else {}
     return RenderSettings(method=choice.method, width=width, height=height, **kwargs)
+
+
+# Quality presets. With method Auto, a preset is an error target for choose(): the fastest measured setting that
+# reaches it (the table's front on the dev box: LPV 16³ reaches 0.07, LPV 32³ 0.056, LPV 32³ with 1024 VPLs 0.05).
+# With a method chosen by hand, a preset is that method's settings: Medium is its defaults.
+QUALITIES = ("DRAFT", "MEDIUM", "HIGH")
+AUTO_TARGETS = {"DRAFT": 0.07, "MEDIUM": 0.056, "HIGH": 0.05}
+PRESETS = {
+    "lpv": {"DRAFT": {"resolution": 16}, "MEDIUM": {}, "HIGH": {"gather_vpls": 1024}},
+    "vct": {"DRAFT": {"resolution": 32, "diffuse_cones": 6, "subrays": 1}, "MEDIUM": {},
+            "HIGH": {"diffuse_cones": 19}},
+}
+
+
+def preset_settings(method: str, quality: str, width: int, height: int, bounces: int = 0, resolution: int = 0):
+    """RenderSettings for a method chosen by hand at a quality preset; `bounces` and `resolution` (grid cells along
+    the longest axis), when not 0, override the preset's (the panel's advanced settings)."""
+    import dataclasses
+
+    from ..gpu_kernels.lpv.settings import LpvSettings
+    from ..gpu_kernels.settings import RenderSettings
+    from ..gpu_kernels.vct.settings import VctSettings
+
+    if quality not in QUALITIES:
+        raise QualityError(f"unknown quality {quality!r} (choose from {', '.join(QUALITIES)})")
+    if method not in PRESETS:
+        return RenderSettings(method=method, width=width, height=height)
+    values = dict(PRESETS[method][quality])
+    values.update({k: v for k, v in (("bounces", bounces), ("resolution", resolution)) if v})
+    cls = LpvSettings if method == "lpv" else VctSettings
+    try:
+        settings = dataclasses.replace(cls(), **values)
+    except ValueError as ex:
+        raise QualityError(f"{method.upper()} settings: {ex}") from None
+    return RenderSettings(method=method, width=width, height=height, **{method: settings})

@@ -152,13 +152,20 @@ def submit_scene(depsgraph, resolution: tuple[int, int]) -> PendingRender:
 
 def render_settings_of(settings, width: int, height: int):
     """The engine's RenderSettings for a scene's Bounce GI settings (properties.BounceGISettings) at width × height:
-    the chosen method with its default settings, or, with the time budget on, what the quality table picks for it.
-    Returns (settings, the budget's one-line explanation or "")."""
-    from ..gpu_kernels.settings import RenderSettings
+    with the time budget on, what the quality table picks for it; with Auto, the table's fastest setting reaching
+    the quality's error; else the chosen method at the quality's preset, with the advanced overrides. Returns
+    (settings, the table choice's one-line explanation or "")."""
+    from ..addon.quality import AUTO_TARGETS, QualityError, preset_settings
 
     if settings.use_time_budget:
         return budget_settings(settings.time_budget_ms, width, height)
-    return RenderSettings(method=settings.method_id(), width=width, height=height), ""
+    if settings.method_id() == "auto":
+        return table_settings(width, height, target_error=AUTO_TARGETS[settings.quality])
+    try:
+        return preset_settings(settings.method_id(), settings.quality, width, height, settings.bounces,
+                               settings.grid_resolution), ""
+    except QualityError as ex:
+        raise PreviewError(one_line(ex)) from None
 
 
 def output_file(path: str) -> str:
@@ -199,11 +206,16 @@ def write_output(path: str, passes: dict) -> None:
 
 def budget_settings(budget_ms: float, width: int, height: int):
     """RenderSettings for a time budget from the measured quality table; (settings, one-line explanation)."""
+    return table_settings(width, height, budget_ms=budget_ms)
+
+
+def table_settings(width: int, height: int, budget_ms=None, target_error=None):
+    """RenderSettings the measured quality table picks for a budget and/or an error target; (settings, why)."""
     from ..addon.quality import QualityError, choose, load_table, render_settings_for
 
     try:
         table = load_table()
-        choice = choose(table, budget_ms=budget_ms)
+        choice = choose(table, budget_ms=budget_ms, target_error=target_error)
     except QualityError as ex:
         raise PreviewError(one_line(ex)) from None
     return render_settings_for(choice, width, height), choice.describe(table)
