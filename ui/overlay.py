@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import bpy
 
-from .viewport import ViewportFeed, region_view
+from .viewport import ViewportFeed, close_all, region_view
 
 DEPTH_PULL = 1e-5  # clip-space w fraction: above depth-buffer precision at the surfaces, far below any gap
 
@@ -52,7 +52,10 @@ def on_depsgraph_update(_scene, depsgraph) -> None:
 
 @bpy.app.handlers.persistent
 def on_load_pre(*_args) -> None:
-    disable()  # the old file's scene must not be drawn over the new one
+    """Another file is loading: the old scene's results must not be drawn over the new one, by the overlay or by
+    a Rendered 3D view (its engine makes a new feed on its next view_update)."""
+    disable()
+    close_all()
 
 
 def enable(depsgraph) -> None:

@@ -98,7 +98,7 @@ class BounceGIRenderEngine(bpy.types.RenderEngine):
     def view_update(self, context, depsgraph):
         from .viewport import ViewportFeed
 
-        first = self.feed is None
+        first = self.feed is None or self.feed.session.closed  # closed: another file was loaded
         if first:
             self.feed = ViewportFeed(on_update=self.tag_redraw)
         self.feed.update(depsgraph, first=first)

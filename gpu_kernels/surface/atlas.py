@@ -79,21 +79,27 @@ def choose_texel(positions: np.ndarray, budget: int) -> float:
 
 
 def pack_tiles(tile: np.ndarray) -> tuple[np.ndarray, int, int]:
-    """Lower-left texel of every tile, packed in rows: tiles of equal size side by side, the largest first.
-    Returns (origins (T, 2) int32, width, height)."""
+    """Lower-left texel of every tile, packed in shelves, the largest tiles first: a shelf is as tall as its first
+    tile, and each column of it stacks tiles of one size up to the shelf's height, so small tiles fill the space
+    beside big ones. Returns (origins (T, 2) int32, width, height)."""
     total = int(np.sum(tile.astype(np.int64) ** 2))
-    width = int(min(MAX_WIDTH, max(int(tile.max()) if tile.size else 1,
-                                   1 << int(np.ceil(np.log2(max(1.0, np.sqrt(total * 1.1))))))))
+    width = int(min(MAX_WIDTH, max(int(tile.max()) if tile.size else 1, -(-int(np.sqrt(total * 1.05)) // 8) * 8)))
     origin = np.zeros((tile.size, 2), np.int32)
-    y = 0
-    for k in sorted(set(tile.tolist()), reverse=True):
-        idx = np.flatnonzero(tile == k)
-        per_row = width // k
-        i = np.arange(idx.size)
-        origin[idx, 0] = (i % per_row) * k
-        origin[idx, 1] = y + (i // per_row) * k
-        y += -(-idx.size // per_row) * k
-    return origin, width, max(1, y)
+    x = shelf_y = shelf_h = 0
+    col_x = col_k = col_fill = -1
+    for idx in np.argsort(-tile, kind="stable"):
+        k = int(tile[idx])
+        if k == col_k and col_fill + k <= shelf_h:  # the open column has room for one more
+            origin[idx] = (col_x, shelf_y + col_fill)
+            col_fill += k
+            continue
+        if x + k > width:  # a new shelf, as tall as this tile
+            shelf_y, shelf_h, x = shelf_y + shelf_h, 0, 0
+        shelf_h = max(shelf_h, k)
+        col_x, col_k, col_fill = x, k, k
+        origin[idx] = (x, shelf_y)
+        x += k
+    return origin, width, max(1, shelf_y + shelf_h)
 
 
 def build_atlas(scene: Scene, budget: int) -> SurfaceAtlas:

@@ -34,15 +34,17 @@ vec3 atlas_lookup(sampler2D atlas, vec2 c) {
 }
 
 void main() {
-    vec3 view_dir = u_eye.w > 0.5 ? -u_forward.xyz : normalize(u_eye.xyz - v_position);
-    vec3 n = normalize(v_normal);
+    vec3 to_eye = u_eye.w > 0.5 ? -u_forward.xyz : u_eye.xyz - v_position;
     // Two-sided as in Cycles: seen from behind, the surface is lit by the atlas's back page.
-    bool back = dot(v_geo_normal, view_dir) < 0.0;
-    if (back) n = -n;
+    bool back = dot(v_geo_normal, to_eye) < 0.0;
     // Stay on this triangle's texel centres: the 2×2 footprint never reaches a neighbouring tile.
     vec2 c = clamp(v_tile, v_box.xy + 0.5, v_box.xy + vec2(v_box.z) - 0.5);
     vec2 page = vec2(0.0, back ? u_forward.w : 0.0);
-    float share = (1.0 - v_mat.x) * (v_mat.z > 0.5 ? principled_diffuse_share(dot(n, view_dir), v_mat.y) : 1.0);
+    float share = 1.0 - v_mat.x;
+    if (v_mat.z > 0.5) {  // Principled's specular layer: the diffuse share depends on the view (μ = n·v)
+        vec3 n = normalize(v_normal) * (back ? -1.0 : 1.0);
+        share *= principled_diffuse_share(dot(n, normalize(to_eye)), v_mat.y);
+    }
     vec3 direct = share * atlas_lookup(u_direct, c + page);
     vec3 indirect = share * atlas_lookup(u_indirect, c + page);
     int mode = int(u_params.x + 0.5);
