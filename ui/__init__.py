@@ -15,6 +15,9 @@ modules = (properties, operators, overlay, render_engine, panel)
 def register():
     for module in modules:
         module.register()
+    from . import viewport
+
+    viewport.warm_up()
 
 
 def unregister():

@@ -31,16 +31,35 @@ def main():
     parser.add_argument("--bounces", type=int, default=8, help="Cycles bounces of the reference")
     parser.add_argument("--lpv", nargs="+", default=[])
     parser.add_argument("--vct", nargs="+", default=[])
+    parser.add_argument("--snapshot", action="store_true",
+                        help="also draw the viewport's view (bounce-gi snapshot) and compare its Combined")
     args = parser.parse_args()
     out = {}
     for name in args.names:
         scenes.build(name)
         scene = extract_scene(bpy.context.evaluated_depsgraph_get())
-        report, *_ = compare(scene, args.method, args.samples, args.bounces, progress=lambda m: None,
-                             lpv_options=parse_method_options(args.lpv), vct_settings=vct_options(args.vct))
+        report, result, ref, mask = compare(scene, args.method, args.samples, args.bounces, progress=lambda m: None,
+                                            lpv_options=parse_method_options(args.lpv),
+                                            vct_settings=vct_options(args.vct))
+        if args.snapshot:
+            add_snapshot(report, scene, args, result, ref, mask)
         out[name] = report
     sys.stdout.flush()
     print("RESULT " + json.dumps(out), flush=True)
+
+
+def add_snapshot(report, scene, args, result, ref, mask):
+    """report["rel_l1"]["snapshot_combined"] (against Cycles) and ["snapshot_vs_render"] (against our render)."""
+    from bounce_gi.addon.cli.options import method_settings
+    from bounce_gi.gpu_kernels.engine import get_engine
+    from bounce_gi.gpu_kernels.output import metrics
+    from bounce_gi.ui import draw
+
+    settings = method_settings(scene, args.method, args.lpv, args.vct)
+    light = get_engine().submit_surface(scene, settings, 65536).result()
+    shot = draw.snapshot(light, scene, *scene.resolution)
+    report["rel_l1"]["snapshot_combined"] = metrics.rel_l1(shot, ref.passes["Combined"], mask)
+    report["rel_l1"]["snapshot_vs_render"] = metrics.rel_l1(shot, result.passes["Combined"], mask)
 
 
 if __name__ == "__main__":
