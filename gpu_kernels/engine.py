@@ -9,7 +9,7 @@ from .gl.context import GpuWorker
 from .pipeline import Pipeline, RenderResult
 from .scene import Scene
 from .settings import RenderSettings, check_method, check_renderable
-from .surface.atlas import build_atlas
+from .surface.atlas import INDIRECT_SHARE, build_atlas
 
 _engine = None
 _lock = threading.Lock()
@@ -25,12 +25,16 @@ class Engine:
         check_renderable(scene, settings)  # fail fast, on the caller's thread, for bad input
         return self.worker.submit(self._render, scene, settings)
 
-    def submit_surface(self, scene: Scene, settings: RenderSettings, budget: int) -> Future:
-        """Queue the view-independent lighting of `scene` on a surface atlas of at most `budget` texels per page
-        (pipeline.render_surface); the Future resolves to a SurfaceLight. The atlas is laid out on the worker
-        thread too, so the caller (Blender's main thread) never waits for it."""
+    def submit_surface(self, scene: Scene, settings: RenderSettings, budget: int,
+                       indirect_budget: int | None = None) -> Future:
+        """Queue the view-independent lighting of `scene` on a surface atlas of at most `budget` texels per page,
+        the indirect light on one of `indirect_budget` (default budget / atlas.INDIRECT_SHARE; equal to `budget`:
+        the same atlas) (pipeline.render_surface); the Future
+        resolves to a SurfaceLight. The atlases are laid out on the worker thread too, so the caller (Blender's
+        main thread) never waits for them."""
         check_method(settings)
-        return self.worker.submit(self._render_surface, scene, settings, int(budget))
+        indirect_budget = max(1, budget // INDIRECT_SHARE) if indirect_budget is None else indirect_budget
+        return self.worker.submit(self._render_surface, scene, settings, int(budget), int(indirect_budget))
 
     def render(self, scene: Scene, settings: RenderSettings) -> RenderResult:
         return self.submit_render(scene, settings).result()
@@ -40,10 +44,12 @@ class Engine:
             self._pipeline = Pipeline(ctx)
         return self._pipeline.render(scene, settings)
 
-    def _render_surface(self, ctx, scene, settings, budget):
+    def _render_surface(self, ctx, scene, settings, budget, indirect_budget):
         if self._pipeline is None:
             self._pipeline = Pipeline(ctx)
-        return self._pipeline.render_surface(scene, settings, build_atlas(scene, budget))
+        atlas = build_atlas(scene, budget)
+        coarse = None if indirect_budget == budget else build_atlas(scene, indirect_budget)
+        return self._pipeline.render_surface(scene, settings, atlas, coarse)
 
     @property
     def pipeline(self) -> Pipeline | None:

@@ -52,7 +52,8 @@ class RenderResult:
 
 @dataclass
 class SurfaceLight:
-    """render_surface's result: the atlas and, per texel of both pages, (2H, W, 3) float32, rows bottom-up."""
+    """render_surface's result: the atlas and, per texel of both pages, (2H, W, 3) float32, rows bottom-up; the
+    indirect light in its own (coarser) atlas's layout."""
     atlas: SurfaceAtlas
     direct: np.ndarray  # Diffuse Direct (irradiance / π)
     indirect: np.ndarray  # Diffuse Indirect (zeros for method "none")
@@ -64,6 +65,8 @@ class SurfaceLight:
     method: str
     statistics: dict = field(default_factory=dict)  # Scene.statistics(): triangles, lights by type, bounds
     info: dict = field(default_factory=dict)  # the method's details, as RenderResult.info (grids, bounces)
+    indirect_atlas: SurfaceAtlas | None = None  # the layout `indirect` is in (None: `atlas`)
+    indirect_base: np.ndarray | None = None  # base colours in that layout
 
 
 @dataclass
@@ -81,6 +84,10 @@ class FrameInputs:
     shadows: sh.ShadowAtlas
     gbuffer: gb.GBuffer
     keys: dict
+
+
+def surface_base(scene: Scene, atlas: SurfaceAtlas) -> np.ndarray:
+    return sgb.base_colors(scene, atlas, sgb.surface_points(scene, atlas))
 
 
 METHOD_PASSES = {"lpv": lpv_passes.run, "vct": vct_passes.run}  # "none": direct light only
@@ -119,31 +126,36 @@ class Pipeline:
                             statistics=scene.statistics(), method=settings.method,
                             resolution=(settings.width, settings.height), info=out.info if out else {})
 
-    def render_surface(self, scene: Scene, settings: RenderSettings, atlas: SurfaceAtlas) -> SurfaceLight:
+    def render_surface(self, scene: Scene, settings: RenderSettings, atlas: SurfaceAtlas,
+                       indirect_atlas: SurfaceAtlas | None = None) -> SurfaceLight:
         """Diffuse Direct and Diffuse Indirect at every texel of a surface atlas (surface/atlas.py): the same passes
         as render(), on the atlas's G-buffer instead of the camera's. View-independent, so the viewport draws it
-        from any camera. Per-pixel refinements that need a camera are off: VCT's upsampling (its neighbours
-        would be other triangles' texels) and temporal accumulation."""
+        from any camera. The indirect light may be computed on a coarser atlas of the same triangles (it varies
+        slowly; its gather is the expensive part). Per-pixel refinements that need a camera are off: VCT's
+        upsampling (its neighbours would be other triangles' texels) and temporal accumulation."""
         check_method(settings)  # no camera needed: the viewport has its own
         start = time.perf_counter()
+        indirect_atlas = indirect_atlas or atlas
         vct = replace(settings.vct, indirect_scale=1, temporal_frames=0, specular_cone=False)
         settings = replace(settings, vct=vct)
         self.cache.begin_frame()
         frame = self._direct_passes(scene, settings, atlas)
         direct_tex = self.cache.run("direct_light", frame.keys["direct"], lambda: lighting.render_direct_light(
             self.ctx, self.programs, frame.gbuffer, frame.shadows))
-        method = METHOD_PASSES.get(settings.method)
-        out = method(frame) if method else None
         gl_rows = slice(None, None, -1)  # read_texture gives image order; the atlas keeps GL's
         direct = read_texture(direct_tex, 3)[gl_rows]
-        indirect = np.zeros_like(direct) if out is None or out.indirect is None else \
-            read_texture(out.indirect, 3)[gl_rows]
-        base = sgb.base_colors(scene, atlas, sgb.surface_points(scene, atlas))
+        method = METHOD_PASSES.get(settings.method)
+        if method and indirect_atlas is not atlas:
+            frame = self._direct_passes(scene, settings, indirect_atlas)
+        out = method(frame) if method else None
+        indirect = np.zeros((2 * indirect_atlas.height, indirect_atlas.width, 3), np.float32) \
+            if out is None or out.indirect is None else read_texture(out.indirect, 3)[gl_rows]
         timings = dict(self.cache.timings)
         timings["total"] = time.perf_counter() - start
-        return SurfaceLight(atlas, direct, indirect, base, draw_arrays(scene, atlas), timings,
-                            list(self.cache.skipped), list(scene.warnings) + list(frame.shadows.warnings),
-                            settings.method, scene.statistics(), out.info if out else {})
+        return SurfaceLight(atlas, direct, indirect, surface_base(scene, atlas),
+                            draw_arrays(scene, atlas, indirect_atlas), timings, list(self.cache.skipped), list(scene.warnings) + list(frame.shadows.warnings),
+                            settings.method, scene.statistics(), out.info if out else {}, indirect_atlas,
+                            surface_base(scene, indirect_atlas))
 
     def _direct_passes(self, scene: Scene, settings: RenderSettings, atlas: SurfaceAtlas | None = None) -> FrameInputs:
         """The passes every method shares, up to the G-buffer and the shadow maps, and the keys they ran under.

@@ -3,8 +3,8 @@
 (render_engine.view_draw), the Solid-mode overlay (overlay.py) and `bounce-gi snapshot`.
 
 A GI update's result (pipeline.SurfaceLight: the surface atlas's light and the triangles to draw) becomes a
-SurfaceDrawing once, on the main thread: two 2D textures (direct and indirect light × base colour) and one vertex
-batch. Blender's textures cannot be
+SurfaceDrawing once, on the main thread: two 2D textures (direct and indirect light × base colour, each in its
+own atlas) and one vertex batch. Blender's textures cannot be
 updated in place, so a new result makes new ones and the old are freed. Drawing it from a camera runs no GI
 pass: the fragment shader (gpu_kernels/shaders/viewport/surface.glsl) looks the light up per pixel.
 
@@ -39,9 +39,9 @@ def surface_shader():
     global _shader
     if _shader is None:
         iface = gpu.types.GPUStageInterfaceInfo("bounce_gi_surface_iface")
-        for name, n in (("v_position", 3), ("v_normal", 3), ("v_tile", 2)):
+        for name, n in (("v_position", 3), ("v_normal", 3), ("v_tile", 2), ("v_tile_i", 2)):
             iface.smooth(GLSL_TYPES[n], name)
-        for name, n in (("v_geo_normal", 3), ("v_box", 3), ("v_mat", 3), ("v_emission", 3)):
+        for name, n in (("v_geo_normal", 3), ("v_box", 3), ("v_box_i", 3), ("v_mat", 3), ("v_emission", 3)):
             iface.flat(GLSL_TYPES[n], name)
         info = gpu.types.GPUShaderCreateInfo()
         for name, glsl_type in (("u_view_projection", "MAT4"), ("u_eye", "VEC4"), ("u_forward", "VEC4"),
@@ -92,10 +92,12 @@ class SurfaceDrawing:
     def __init__(self, light):
         from gpu_extras.batch import batch_for_shader
 
-        self.page_height = int(light.atlas.height)
-        base = np.concatenate([light.base, light.base])  # both pages: the same surfaces' colours
-        self.textures = {"u_direct": rgba_texture(light.direct * base),
-                         "u_indirect": rgba_texture(light.indirect * base)}
+        coarse = light.indirect_atlas or light.atlas
+        coarse_base = light.base if light.indirect_base is None else light.indirect_base
+        self.page_heights = (int(light.atlas.height), int(coarse.height))
+        # Both pages of an atlas show the same surfaces' colours.
+        self.textures = {"u_direct": rgba_texture(light.direct * np.concatenate([light.base, light.base])),
+                         "u_indirect": rgba_texture(light.indirect * np.concatenate([coarse_base, coarse_base]))}
         self.triangles = len(light.mesh["pos"]) // 3
         self.batch = batch_for_shader(surface_shader(), "TRIS", light.mesh) if self.triangles else None
 
@@ -107,8 +109,8 @@ class SurfaceDrawing:
         shader.bind()
         shader.uniform_float("u_view_projection", Matrix(np.asarray(view.view_projection, float).tolist()))
         shader.uniform_float("u_eye", (*view.eye, 1.0 if view.ortho else 0.0))
-        shader.uniform_float("u_forward", (*view.forward, float(self.page_height)))
-        shader.uniform_float("u_params", (float(MODES[mode]), float(depth_pull), 0.0, 0.0))
+        shader.uniform_float("u_forward", (*view.forward, float(self.page_heights[0])))
+        shader.uniform_float("u_params", (float(MODES[mode]), float(depth_pull), float(self.page_heights[1]), 0.0))
         for name, texture in self.textures.items():
             shader.uniform_sampler(name, texture)
         gpu.state.depth_test_set("LESS_EQUAL")

@@ -16,7 +16,8 @@ from dataclasses import dataclass, field, replace
 
 from .preview import one_line
 
-# (name, texels per atlas page, draft settings?) in the order they run; "direct" renders method "none".
+# (name, texels per atlas page, draft settings?) in the order they run; "direct" renders method "none". (The
+# indirect light's atlas has fewer texels: surface/atlas.INDIRECT_SHARE.)
 STAGES = (("direct", 16384, False), ("draft", 16384, True), ("final", 65536, False))
 POLL_SECONDS = 0.02
 

@@ -59,10 +59,10 @@ def test_the_overlay_follows_edits_and_draws_what_f12_renders(linux_zip, tmp_pat
         shot = draw.snapshot(light_result, data, 64, 48)[..., :3]
         rel = float(np.abs(shot - f12).sum() / np.abs(f12).sum())
         print("snapshot vs F12 rel-L1", rel)
-        # Measured 0.0048 here (LPV, 64x48): the atlas's texels against pixels, at shadow edges and corners. Both
-        # paths are deterministic; the margin covers only the texel size (a bisection) rounding differently on
-        # another machine.
-        assert rel < 0.0068
+        # Measured 0.0082 here (LPV, 64x48; the indirect light on its coarser atlas): the atlas's texels against
+        # pixels, at shadow edges and corners. Both paths are deterministic; the margin covers only the texel size
+        # (a bisection) rounding differently on another machine.
+        assert rel < 0.0102
 
         bpy.ops.bounce_gi.toggle_overlay()
         handlers = [h for h in bpy.app.handlers.depsgraph_update_post if "bounce" in getattr(h, "__module__", "")]

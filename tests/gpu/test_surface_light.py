@@ -62,7 +62,8 @@ def test_the_wall_beside_the_lit_patch_gets_the_patch_s_view_factor_at_every_tex
     scene = lit_patch_scene("wall beside")
     settings = RenderSettings(method, 64, 64, vct=VctSettings(resolution=64, bounces=1))
     r = engine.submit_surface(scene, settings, BUDGET).result()
-    ys, xs, points = _texels(scene, r.atlas, [12, 13])  # the wall's two triangles
+    assert r.indirect_atlas.texel_count < r.atlas.texel_count  # a coarser atlas of its own
+    ys, xs, points = _texels(scene, r.indirect_atlas, [12, 13])  # the wall's two triangles
     p = points["position"][ys, xs].astype(np.float64)
     n = points["geo_normal"][ys, xs].astype(np.float64)
     assert np.allclose(n, (1, 0, 0), atol=1e-6)

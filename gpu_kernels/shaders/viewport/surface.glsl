@@ -6,9 +6,13 @@
 // material as the G-buffer computes it (common/principled.glsl), plus emission: Cycles' Combined without the
 // glossy part, from any camera, with no GI pass per view.
 //
+// The indirect light has an atlas of its own, coarser than the direct light's (it varies slowly): each vertex
+// carries its place in both (tile / box, tile_i / box_i).
+//
 // Push constants: u_view_projection; u_eye (xyz camera position, w 1 if orthographic); u_forward (xyz unit view
-// axis, w the atlas page height in texels); u_params (x: 0 Combined, 1 indirect only, 2 direct only; y: depth
-// pulled toward the camera, in clip w — the overlay draws over Blender's own copy of the same surfaces).
+// axis, w the direct atlas's page height in texels); u_params (x: 0 Combined, 1 indirect only, 2 direct only; y:
+// depth pulled toward the camera, in clip w — the overlay draws over Blender's own copy of the same surfaces;
+// z: the indirect atlas's page height).
 
 #if defined(VERTEX_SHADER)
 void main() {
@@ -17,6 +21,8 @@ void main() {
     v_geo_normal = geo;
     v_tile = tile;
     v_box = box;
+    v_tile_i = tile_i;
+    v_box_i = box_i;
     v_mat = mat;
     v_emission = emission;
     gl_Position = u_view_projection * vec4(pos, 1.0);
@@ -39,14 +45,14 @@ void main() {
     bool back = dot(v_geo_normal, to_eye) < 0.0;
     // Stay on this triangle's texel centres: the 2×2 footprint never reaches a neighbouring tile.
     vec2 c = clamp(v_tile, v_box.xy + 0.5, v_box.xy + vec2(v_box.z) - 0.5);
-    vec2 page = vec2(0.0, back ? u_forward.w : 0.0);
+    vec2 c_i = clamp(v_tile_i, v_box_i.xy + 0.5, v_box_i.xy + vec2(v_box_i.z) - 0.5);
     float share = 1.0 - v_mat.x;
     if (v_mat.z > 0.5) {  // Principled's specular layer: the diffuse share depends on the view (μ = n·v)
         vec3 n = normalize(v_normal) * (back ? -1.0 : 1.0);
         share *= principled_diffuse_share(dot(n, normalize(to_eye)), v_mat.y);
     }
-    vec3 direct = share * atlas_lookup(u_direct, c + page);
-    vec3 indirect = share * atlas_lookup(u_indirect, c + page);
+    vec3 direct = share * atlas_lookup(u_direct, c + vec2(0.0, back ? u_forward.w : 0.0));
+    vec3 indirect = share * atlas_lookup(u_indirect, c_i + vec2(0.0, back ? u_params.z : 0.0));
     int mode = int(u_params.x + 0.5);
     vec3 color = mode == 1 ? indirect : mode == 2 ? direct + v_emission : direct + indirect + v_emission;
     out_color = vec4(color, 1.0);
