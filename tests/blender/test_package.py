@@ -179,7 +179,8 @@ def test_register_unregister_twice(tmp_path):
             bounce_gi.register()
             assert hasattr(bpy.types.Scene, "bounce_gi") and hasattr(bpy.types, "BOUNCE_GI_OT_render_preview")
             s = bpy.context.scene.bounce_gi
-            assert (s.method, s.resolution_percentage, s.output_path) == ("VCT", 50, "")
+            assert (s.method, s.quality, s.resolution_percentage, s.output_path) == ("AUTO", "MEDIUM", 50, "")
+            assert hasattr(bpy.types, "BOUNCE_GI_OT_toggle_overlay")
             assert bounce_gi.ui.render_engine.BounceGIRenderEngine.is_registered
             assert "BOUNCE_GI" in bpy.types.DATA_PT_light.COMPAT_ENGINES
             bounce_gi.unregister()
@@ -188,7 +189,9 @@ def test_register_unregister_twice(tmp_path):
             assert not hasattr(bpy.types.Scene, "bounce_gi")
             assert not hasattr(bpy.types, "BOUNCE_GI_OT_render_preview")
             assert not hasattr(bpy.types, "VIEW3D_PT_bounce_gi")
-            assert not [h for h in bpy.app.handlers.load_post if h.__module__.startswith("bounce_gi")]
+            assert not [h for h in (*bpy.app.handlers.load_post, *bpy.app.handlers.load_pre,
+                                    *bpy.app.handlers.depsgraph_update_post) if h.__module__.startswith("bounce_gi")]
+            assert not hasattr(bpy.types, "BOUNCE_GI_OT_toggle_overlay")
             print("round", round_, "OK")
     """
     out = run_python(code, env={**package_path_env(tmp_path), "BLENDER_USER_RESOURCES": str(tmp_path)})
