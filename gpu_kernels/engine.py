@@ -29,27 +29,35 @@ class Engine:
                        indirect_budget: int | None = None) -> Future:
         """Queue the view-independent lighting of `scene` on a surface atlas of at most `budget` texels per page,
         the indirect light on one of `indirect_budget` (default budget / atlas.INDIRECT_SHARE; equal to `budget`:
-        the same atlas) (pipeline.render_surface); the Future
-        resolves to a SurfaceLight. The atlases are laid out on the worker thread too, so the caller (Blender's
-        main thread) never waits for them."""
+        the same atlas) (pipeline.render_surface); the Future resolves to a SurfaceLight. The atlases are laid out
+        on the worker thread too, so the caller (Blender's main thread) never waits for them."""
         check_method(settings)
         indirect_budget = max(1, budget // INDIRECT_SHARE) if indirect_budget is None else indirect_budget
         return self.worker.submit(self._render_surface, scene, settings, int(budget), int(indirect_budget))
+
+    def submit_points(self, scene: Scene, settings: RenderSettings, positions, normals) -> Future:
+        """Queue the light at N points with normals (pipeline.render_points, e.g. mesh vertices for a bake); the
+        Future resolves to a PointLight."""
+        check_method(settings)
+        return self.worker.submit(lambda ctx: self._ensure_pipeline(ctx).render_points(
+            scene, settings, positions, normals))
+
+    def _ensure_pipeline(self, ctx) -> Pipeline:
+        """The pipeline, made on the worker thread by its first job."""
+        if self._pipeline is None:
+            self._pipeline = Pipeline(ctx)
+        return self._pipeline
 
     def render(self, scene: Scene, settings: RenderSettings) -> RenderResult:
         return self.submit_render(scene, settings).result()
 
     def _render(self, ctx, scene, settings):
-        if self._pipeline is None:
-            self._pipeline = Pipeline(ctx)
-        return self._pipeline.render(scene, settings)
+        return self._ensure_pipeline(ctx).render(scene, settings)
 
     def _render_surface(self, ctx, scene, settings, budget, indirect_budget):
-        if self._pipeline is None:
-            self._pipeline = Pipeline(ctx)
         atlas = build_atlas(scene, budget)
         coarse = None if indirect_budget == budget else build_atlas(scene, indirect_budget)
-        return self._pipeline.render_surface(scene, settings, atlas, coarse)
+        return self._ensure_pipeline(ctx).render_surface(scene, settings, atlas, coarse)
 
     @property
     def pipeline(self) -> Pipeline | None:

@@ -86,6 +86,24 @@ class FrameInputs:
     keys: dict
 
 
+@dataclass
+class PointLight:
+    """render_points' result: per point, (N, 3) float32."""
+    direct: np.ndarray  # Diffuse Direct (irradiance / π)
+    indirect: np.ndarray  # Diffuse Indirect (zeros for method "none")
+    timings: dict
+    warnings: list
+    method: str
+
+
+def surface_settings(settings: RenderSettings) -> RenderSettings:
+    """Settings for light at surface points rather than pixels: the per-pixel refinements that need a camera are
+    off — VCT's upsampling (its neighbours would be other triangles' texels), temporal accumulation and the
+    specular cone (no view direction)."""
+    vct = replace(settings.vct, indirect_scale=1, temporal_frames=0, specular_cone=False)
+    return replace(settings, vct=vct)
+
+
 def surface_base(scene: Scene, atlas: SurfaceAtlas) -> np.ndarray:
     return sgb.base_colors(scene, atlas, sgb.surface_points(scene, atlas))
 
@@ -131,40 +149,60 @@ class Pipeline:
         """Diffuse Direct and Diffuse Indirect at every texel of a surface atlas (surface/atlas.py): the same passes
         as render(), on the atlas's G-buffer instead of the camera's. View-independent, so the viewport draws it
         from any camera. The indirect light may be computed on a coarser atlas of the same triangles (it varies
-        slowly; its gather is the expensive part). Per-pixel refinements that need a camera are off: VCT's
-        upsampling (its neighbours would be other triangles' texels) and temporal accumulation."""
-        check_method(settings)  # no camera needed: the viewport has its own
+        slowly; its gather is the expensive part)."""
         start = time.perf_counter()
         indirect_atlas = indirect_atlas or atlas
-        vct = replace(settings.vct, indirect_scale=1, temporal_frames=0, specular_cone=False)
-        settings = replace(settings, vct=vct)
-        self.cache.begin_frame()
-        frame = self._direct_passes(scene, settings, atlas)
-        direct_tex = self.cache.run("direct_light", frame.keys["direct"], lambda: lighting.render_direct_light(
-            self.ctx, self.programs, frame.gbuffer, frame.shadows))
-        gl_rows = slice(None, None, -1)  # read_texture gives image order; the atlas keeps GL's
-        direct = read_texture(direct_tex, 3)[gl_rows]
-        method = METHOD_PASSES.get(settings.method)
-        if method and indirect_atlas is not atlas:
-            frame = self._direct_passes(scene, settings, indirect_atlas)
-        out = method(frame) if method else None
+        settings = surface_settings(settings)
+        direct, frame, _ = self._lit_samples(scene, settings, sgb.atlas_samples(scene, atlas), direct_only=True)
+        _, frame, out = self._lit_samples(scene, settings, sgb.atlas_samples(scene, indirect_atlas), direct=False)
         indirect = np.zeros((2 * indirect_atlas.height, indirect_atlas.width, 3), np.float32) \
-            if out is None or out.indirect is None else read_texture(out.indirect, 3)[gl_rows]
+            if out is None or out.indirect is None else read_texture(out.indirect, 3)[::-1]
         timings = dict(self.cache.timings)
         timings["total"] = time.perf_counter() - start
         return SurfaceLight(atlas, direct, indirect, surface_base(scene, atlas),
-                            draw_arrays(scene, atlas, indirect_atlas), timings, list(self.cache.skipped), list(scene.warnings) + list(frame.shadows.warnings),
+                            draw_arrays(scene, atlas, indirect_atlas), timings,
+                            list(self.cache.skipped), list(scene.warnings) + list(frame.shadows.warnings),
                             settings.method, scene.statistics(), out.info if out else {}, indirect_atlas,
                             surface_base(scene, indirect_atlas))
 
-    def _direct_passes(self, scene: Scene, settings: RenderSettings, atlas: SurfaceAtlas | None = None) -> FrameInputs:
+    def render_points(self, scene: Scene, settings: RenderSettings, positions, normals) -> PointLight:
+        """Diffuse Direct and Diffuse Indirect (irradiance / π) at N points with normals (N, 3): the passes of
+        render_surface on a G-buffer of those points (a bake to mesh vertices)."""
+        start = time.perf_counter()
+        settings = surface_settings(settings)
+        samples = sgb.point_samples(positions, normals)
+        direct, frame, out = self._lit_samples(scene, settings, samples)
+        n = len(np.asarray(positions).reshape(-1, 3))
+        indirect = np.zeros_like(direct) if out is None or out.indirect is None else \
+            read_texture(out.indirect, 3)[::-1]
+        timings = dict(self.cache.timings)
+        timings["total"] = time.perf_counter() - start
+        return PointLight(direct.reshape(-1, 3)[:n], indirect.reshape(-1, 3)[:n], timings,
+                          list(scene.warnings) + list(frame.shadows.warnings), settings.method)
+
+    def _lit_samples(self, scene, settings, samples, direct: bool = True, direct_only: bool = False):
+        """Run the passes on `samples`' G-buffer: (Diffuse Direct as (H, W, 3) rows bottom-up or None, the frame,
+        the method's output or None)."""
+        check_method(settings)  # no camera needed
+        if direct:
+            self.cache.begin_frame()
+        frame = self._direct_passes(scene, settings, samples)
+        image = None
+        if direct:
+            tex = self.cache.run("direct_light", frame.keys["direct"], lambda: lighting.render_direct_light(
+                self.ctx, self.programs, frame.gbuffer, frame.shadows))
+            image = read_texture(tex, 3)[::-1]  # read_texture gives image order; samples keep GL's
+        method = None if direct_only else METHOD_PASSES.get(settings.method)
+        return image, frame, (method(frame) if method else None)
+
+    def _direct_passes(self, scene: Scene, settings: RenderSettings, samples: sgb.Samples | None = None) -> FrameInputs:
         """The passes every method shares, up to the G-buffer and the shadow maps, and the keys they ran under.
-        The G-buffer is the camera's, or with `atlas` the surface atlas's (render_surface)."""
+        The G-buffer is the camera's, or with `samples` that of surface points (render_surface, render_points)."""
         ctx, programs, cache = self.ctx, self.programs, self.cache
         keys = {"geometry": hash_parts(scene.positions, scene.normals, scene.uvs, scene.material_index),
                 "materials": hash_parts(scene.materials, scene.textures), "lights": hash_parts(scene.lights),
                 "camera": hash_parts(scene.camera, scene.pixel_aspect, settings.width, settings.height)
-                if atlas is None else ("atlas", atlas.key),
+                if samples is None else samples.key,
                 "world": hash_parts(scene.world)}
         geometry = cache.run("geometry", (keys["geometry"],), lambda: geo.upload_geometry(ctx, programs, scene))
         textures = cache.run("textures", (keys["materials"],), lambda: geo.upload_textures(ctx, scene))
@@ -172,12 +210,11 @@ class Pipeline:
         shadows = cache.run("shadow_maps", keys["shadow"],
                             lambda: sh.render_shadow_atlas(ctx, programs, scene, geometry, settings.shadow))
         keys["gbuffer"] = (keys["geometry"], keys["materials"], keys["camera"])
-        if atlas is None:
+        if samples is None:
             gbuffer = cache.run("gbuffer", keys["gbuffer"], lambda: gb.render_gbuffer(
                 ctx, programs, scene, geometry, textures, settings.width, settings.height))
         else:
-            gbuffer = cache.run("gbuffer", keys["gbuffer"], lambda: sgb.upload_gbuffer(
-                ctx, sgb.gbuffer_arrays(sgb.surface_points(scene, atlas))))
+            gbuffer = cache.run("gbuffer", keys["gbuffer"], lambda: sgb.upload_gbuffer(ctx, samples.arrays()))
         keys["direct"] = (keys["gbuffer"], keys["shadow"])
         return FrameInputs(ctx, programs, cache, scene, settings, geometry, textures, shadows, gbuffer, keys)
 

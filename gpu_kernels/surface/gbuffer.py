@@ -10,11 +10,48 @@ texels without a glossy closure).
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+from typing import Callable
+
 import numpy as np
 
 from ..direct.gbuffer import GBUFFER_TARGETS, GBuffer
-from ..scene import Scene
+from ..scene import Scene, hash_parts
 from .atlas import SurfaceAtlas
+
+
+POINTS_PER_ROW = 256
+
+
+@dataclass(frozen=True)
+class Samples:
+    """Surface points lit instead of the camera's pixels (pipeline.render_surface / render_points): the content
+    key of their G-buffer and a function that builds its arrays (gbuffer_arrays' layout)."""
+    key: tuple
+    arrays: Callable[[], dict]
+
+
+def atlas_samples(scene: Scene, atlas: SurfaceAtlas) -> Samples:
+    return Samples(("atlas", atlas.key), lambda: gbuffer_arrays(surface_points(scene, atlas)))
+
+
+def point_samples(positions: np.ndarray, normals: np.ndarray) -> Samples:
+    """N points, each lit on the side its normal points to: (ceil(N / POINTS_PER_ROW), POINTS_PER_ROW) "pixels",
+    point i at row i // POINTS_PER_ROW, column i % POINTS_PER_ROW (rows bottom-up)."""
+    pos = np.asarray(positions, np.float32).reshape(-1, 3)
+    nrm = np.asarray(normals, np.float32).reshape(-1, 3)
+    length = np.linalg.norm(nrm, axis=1, keepdims=True)
+    nrm = np.where(length > 1e-12, nrm / np.maximum(length, 1e-12), (0.0, 0.0, 1.0)).astype(np.float32)
+
+    def arrays():
+        n, w = len(pos), POINTS_PER_ROW
+        h = max(1, -(-n // w))
+        out = {name: np.zeros((h * w, 4), np.float32) for name in GBUFFER_TARGETS}
+        out["position"][:n] = np.hstack([pos, np.ones((n, 1), np.float32)])
+        out["normal"][:n, :3] = out["geo_normal"][:n, :3] = nrm
+        out["albedo"][:n] = 1.0
+        return {k: v.reshape(h, w, 4) for k, v in out.items()}
+    return Samples(("points", hash_parts(pos, nrm)), arrays)
 
 
 def surface_points(scene: Scene, atlas: SurfaceAtlas) -> dict:

@@ -75,3 +75,19 @@ def test_the_wall_beside_the_lit_patch_gets_the_patch_s_view_factor_at_every_tex
     assert len(exact) > 100
     assert ratio == pytest.approx(1.0, abs=0.10)
     assert rel_l1 < 0.15
+
+
+def test_points_get_the_light_of_the_atlas_texels_they_coincide_with(engine):
+    # render_points (a bake's vertices) runs the same passes on a G-buffer of arbitrary points: at the atlas's own
+    # texel points and normals it must give the atlas's values (same shaders, same inputs; the indirect light on the
+    # same atlas here), to float precision.
+    scene = lit_patch_scene("wall beside")
+    settings = RenderSettings("lpv", 64, 64)
+    r = engine.submit_surface(scene, settings, 4096, 4096).result()
+    ys, xs, points = _texels(scene, r.atlas, [0, 1, 12, 13])
+    pos, nrm = points["position"][ys, xs], points["geo_normal"][ys, xs]
+    p = engine.submit_points(scene, settings, pos, nrm).result()
+    assert p.direct.shape == p.indirect.shape == (len(ys), 3)
+    np.testing.assert_allclose(p.direct, r.direct[ys, xs], rtol=1e-5, atol=1e-7)
+    np.testing.assert_allclose(p.indirect, r.indirect[ys, xs], rtol=1e-4, atol=1e-6)
+    assert p.direct[:, 0].max() > 0.3 and p.indirect[:, 0].max() > 0.01  # lit, with GI
