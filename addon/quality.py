@@ -37,13 +37,20 @@ class Choice:
                 f"{res[0][0]}x{res[0][1]} on {machine})")
 
 
+_loaded: dict = {}  # path -> (modification time, table): the viewport asks on every depsgraph update
+
+
 def load_table(path: str = TABLE_PATH) -> dict:
     try:
+        stamp = os.stat(path).st_mtime_ns
+        if path in _loaded and _loaded[path][0] == stamp:
+            return _loaded[path][1]
         with open(path) as f:
             table = json.load(f)
         entries = table["entries"]
         if not entries or not all({"method", "settings", "seconds", "rel_l1"} <= set(e) for e in entries):
             raise ValueError("entries lack method/settings/seconds/rel_l1")
+        _loaded[path] = (stamp, table)
         return table
     except FileNotFoundError:
         raise QualityError(f"no quality table at {path}; run `make bench` to measure one") from None

@@ -104,6 +104,13 @@ def surface_settings(settings: RenderSettings) -> RenderSettings:
     return replace(settings, vct=vct)
 
 
+def indirect_image(out, shape) -> np.ndarray:
+    """A method's Diffuse Indirect on surface samples, rows bottom-up; zeros of `shape` without one."""
+    if out is None or out.indirect is None:
+        return np.zeros(shape, np.float32)
+    return read_texture(out.indirect, 3)[::-1]
+
+
 def surface_base(scene: Scene, atlas: SurfaceAtlas) -> np.ndarray:
     return sgb.base_colors(scene, atlas, sgb.surface_points(scene, atlas))
 
@@ -151,49 +158,51 @@ class Pipeline:
         from any camera. The indirect light may be computed on a coarser atlas of the same triangles (it varies
         slowly; its gather is the expensive part)."""
         start = time.perf_counter()
-        indirect_atlas = indirect_atlas or atlas
         settings = surface_settings(settings)
-        direct, frame, _ = self._lit_samples(scene, settings, sgb.atlas_samples(scene, atlas), direct_only=True)
-        _, frame, out = self._lit_samples(scene, settings, sgb.atlas_samples(scene, indirect_atlas), direct=False)
-        indirect = np.zeros((2 * indirect_atlas.height, indirect_atlas.width, 3), np.float32) \
-            if out is None or out.indirect is None else read_texture(out.indirect, 3)[::-1]
+        self.cache.begin_frame()
+        direct, frame = self._direct_at(scene, settings, sgb.atlas_samples(scene, atlas))
+        base = surface_base(scene, atlas)
+        indirect_base = base
+        if indirect_atlas is not None and indirect_atlas is not atlas:
+            frame = self._direct_passes(scene, settings, sgb.atlas_samples(scene, indirect_atlas))
+            indirect_base = surface_base(scene, indirect_atlas)
+        indirect_atlas = indirect_atlas or atlas
+        out = self._method_output(frame)
+        indirect = indirect_image(out, (2 * indirect_atlas.height, indirect_atlas.width, 3))
         timings = dict(self.cache.timings)
         timings["total"] = time.perf_counter() - start
-        return SurfaceLight(atlas, direct, indirect, surface_base(scene, atlas),
-                            draw_arrays(scene, atlas, indirect_atlas), timings,
+        return SurfaceLight(atlas, direct, indirect, base, draw_arrays(scene, atlas, indirect_atlas), timings,
                             list(self.cache.skipped), list(scene.warnings) + list(frame.shadows.warnings),
                             settings.method, scene.statistics(), out.info if out else {}, indirect_atlas,
-                            surface_base(scene, indirect_atlas))
+                            indirect_base)
 
     def render_points(self, scene: Scene, settings: RenderSettings, positions, normals) -> PointLight:
         """Diffuse Direct and Diffuse Indirect (irradiance / π) at N points with normals (N, 3): the passes of
         render_surface on a G-buffer of those points (a bake to mesh vertices)."""
         start = time.perf_counter()
         settings = surface_settings(settings)
-        samples = sgb.point_samples(positions, normals)
-        direct, frame, out = self._lit_samples(scene, settings, samples)
+        self.cache.begin_frame()
+        direct, frame = self._direct_at(scene, settings, sgb.point_samples(positions, normals))
+        indirect = indirect_image(self._method_output(frame), direct.shape)
         n = len(np.asarray(positions).reshape(-1, 3))
-        indirect = np.zeros_like(direct) if out is None or out.indirect is None else \
-            read_texture(out.indirect, 3)[::-1]
         timings = dict(self.cache.timings)
         timings["total"] = time.perf_counter() - start
         return PointLight(direct.reshape(-1, 3)[:n], indirect.reshape(-1, 3)[:n], timings,
                           list(scene.warnings) + list(frame.shadows.warnings), settings.method)
 
-    def _lit_samples(self, scene, settings, samples, direct: bool = True, direct_only: bool = False):
-        """Run the passes on `samples`' G-buffer: (Diffuse Direct as (H, W, 3) rows bottom-up or None, the frame,
-        the method's output or None)."""
+    def _direct_at(self, scene, settings, samples) -> tuple[np.ndarray, FrameInputs]:
+        """Diffuse Direct on `samples`' G-buffer as (H, W, 3), rows bottom-up (the samples' own order), and the
+        frame the method's passes read."""
         check_method(settings)  # no camera needed
-        if direct:
-            self.cache.begin_frame()
         frame = self._direct_passes(scene, settings, samples)
-        image = None
-        if direct:
-            tex = self.cache.run("direct_light", frame.keys["direct"], lambda: lighting.render_direct_light(
-                self.ctx, self.programs, frame.gbuffer, frame.shadows))
-            image = read_texture(tex, 3)[::-1]  # read_texture gives image order; samples keep GL's
-        method = None if direct_only else METHOD_PASSES.get(settings.method)
-        return image, frame, (method(frame) if method else None)
+        tex = self.cache.run("direct_light", frame.keys["direct"], lambda: lighting.render_direct_light(
+            self.ctx, self.programs, frame.gbuffer, frame.shadows))
+        return read_texture(tex, 3)[::-1], frame
+
+    @staticmethod
+    def _method_output(frame):
+        method = METHOD_PASSES.get(frame.settings.method)
+        return method(frame) if method else None
 
     def _direct_passes(self, scene: Scene, settings: RenderSettings, samples: sgb.Samples | None = None) -> FrameInputs:
         """The passes every method shares, up to the G-buffer and the shadow maps, and the keys they ran under.

@@ -14,11 +14,12 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass, field, replace
 
+from ..gpu_kernels.surface.atlas import VIEWPORT_TEXELS
 from .preview import one_line
 
 # (name, texels per atlas page, draft settings?) in the order they run; "direct" renders method "none". (The
 # indirect light's atlas has fewer texels: surface/atlas.INDIRECT_SHARE.)
-STAGES = (("direct", 16384, False), ("draft", 16384, True), ("final", 65536, False))
+STAGES = (("direct", 16384, False), ("draft", 16384, True), ("final", VIEWPORT_TEXELS, False))
 POLL_SECONDS = 0.02
 
 

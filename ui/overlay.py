@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import bpy
 
+from .preview import tag_redraw_all
 from .viewport import ViewportFeed, close_all, region_view
 
 DEPTH_PULL = 1e-5  # clip-space w fraction: above depth-buffer precision at the surfaces, far below any gap
@@ -26,13 +27,6 @@ state = OverlayState()
 
 def is_on() -> bool:
     return state.feed is not None
-
-
-def tag_redraw() -> None:
-    for window in getattr(bpy.context.window_manager, "windows", ()):
-        for area in window.screen.areas:
-            if area.type == "VIEW_3D":
-                area.tag_redraw()
 
 
 def draw_overlay() -> None:
@@ -61,7 +55,7 @@ def on_load_pre(*_args) -> None:
 def enable(depsgraph) -> None:
     if state.feed is not None:
         return
-    state.feed = ViewportFeed(on_update=tag_redraw)
+    state.feed = ViewportFeed(on_update=lambda: tag_redraw_all(("VIEW_3D",)))
     state.draw_handle = bpy.types.SpaceView3D.draw_handler_add(draw_overlay, (), "WINDOW", "POST_VIEW")
     bpy.app.handlers.depsgraph_update_post.append(on_depsgraph_update)
     state.feed.update(depsgraph, first=True)
@@ -76,7 +70,7 @@ def disable() -> None:
     if state.feed is not None:
         state.feed.close()
         state.feed = None
-    tag_redraw()
+    tag_redraw_all(("VIEW_3D",))
 
 
 class BOUNCE_GI_OT_toggle_overlay(bpy.types.Operator):

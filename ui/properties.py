@@ -22,12 +22,11 @@ METHOD_ITEMS = (
 PATH_OPTIONS = {"ANIMATABLE", "PATH_SUPPORTS_BLEND_RELATIVE"} if bpy.app.version >= (4, 5, 0) else {"ANIMATABLE"}
 
 
-def redraw_views(_self, context) -> None:
+def redraw_views(_self, _context) -> None:
     """A display change needs no GI update, only a redraw of every 3D view."""
-    for window in getattr(context.window_manager, "windows", ()):
-        for area in window.screen.areas:
-            if area.type == "VIEW_3D":
-                area.tag_redraw()
+    from .preview import tag_redraw_all
+
+    tag_redraw_all(("VIEW_3D",))
 
 
 class BounceGISettings(PropertyGroup):

@@ -20,9 +20,10 @@ from .bench_command import cmd_bench
 from .compare import cmd_compare, compare, format_compare
 from .options import parse_method_options, render_ours, vct_options
 from .render import cmd_render, format_timings
+from ...gpu_kernels.surface.atlas import VIEWPORT_TEXELS
 from .snapshot import cmd_snapshot
 
-SNAPSHOT_TEXELS = 65536  # the viewport's refined stage (ui/live.py STAGES)
+SNAPSHOT_TEXELS = VIEWPORT_TEXELS  # what the viewport's final stage uses
 
 __all__ = ["main", "build_parser", "CliError", "check_blend_path", "load_scene", "compare", "format_compare",
            "format_timings", "parse_method_options", "render_ours", "vct_options"]

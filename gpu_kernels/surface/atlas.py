@@ -25,6 +25,7 @@ import numpy as np
 from ..scene import Scene, hash_parts
 
 MAX_TILE = 1024  # texels along a tile's side: the budget, not this, limits big triangles (a floor quad needs hundreds)
+VIEWPORT_TEXELS = 65536  # texels per page of the viewport's final stage (and of `bounce-gi snapshot`)
 # The indirect light's atlas has this many times fewer texels than the direct light's (texels twice as wide): it
 # varies slowly, and its gather per texel (VCT's cones) is most of the viewport's GI time.
 INDIRECT_SHARE = 4

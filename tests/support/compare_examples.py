@@ -53,10 +53,11 @@ def add_snapshot(report, scene, args, result, ref, mask):
     from bounce_gi.addon.cli.options import method_settings
     from bounce_gi.gpu_kernels.engine import get_engine
     from bounce_gi.gpu_kernels.output import metrics
+    from bounce_gi.gpu_kernels.surface.atlas import VIEWPORT_TEXELS
     from bounce_gi.ui import draw
 
     settings = method_settings(scene, args.method, args.lpv, args.vct)
-    light = get_engine().submit_surface(scene, settings, 65536).result()
+    light = get_engine().submit_surface(scene, settings, VIEWPORT_TEXELS).result()
     shot = draw.snapshot(light, scene, *scene.resolution)
     report["rel_l1"]["snapshot_combined"] = metrics.rel_l1(shot, ref.passes["Combined"], mask)
     report["rel_l1"]["snapshot_vs_render"] = metrics.rel_l1(shot, result.passes["Combined"], mask)
