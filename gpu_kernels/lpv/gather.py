@@ -56,7 +56,6 @@ def rsm_uniforms(prog, rsm, shadows, downsample: int) -> tuple:
     """Bind what lpv/inject.glsl reads of the RSM and the lights; returns the atlas size in k×k blocks."""
     bind_named(prog, [("u_rsm_position", rsm.position), ("u_rsm_normal", rsm.normal), ("u_rsm_albedo", rsm.albedo)])
     set_uniform(prog, "u_rsm_size", rsm.size)
-    set_uniform(prog, "u_rsm_resolution", int(rsm.resolution))
     set_uniform(prog, "u_downsample", int(downsample))
     bind_light_records(shadows)
     rsm.views_ssbo.bind_to_storage_buffer(3)
@@ -113,10 +112,11 @@ def _fitted(ctx, records: np.ndarray, size: float, block: int, budget: int) -> V
     return VplList(ctx.buffer(payload), len(records), flux, block)
 
 
-def vpl_list(ctx, programs, rsm, shadows, grid: Grid, budget: int) -> VplList:
-    """The RSM as at most `budget` VPLs: k×k texel blocks (intensity-aware, lpv/inject.glsl MODE_LIST), k the
-    smallest power of two whose lit blocks fit (much of an atlas is empty: a sun's map covers the whole grid, a
-    spot's cone a disc). A block spanning two surfaces gives two VPLs; the grid's cell sets the plane tolerance."""
+def rsm_records(ctx, programs, rsm, shadows, grid: Grid, budget: int) -> tuple[np.ndarray, int]:
+    """The RSM as VPL records (VPL_DTYPE) and k: k×k texel blocks (intensity-aware, lpv/inject.glsl MODE_LIST), k the
+    smallest power of two whose lit blocks number at most a few times `budget` (much of an atlas is empty: a
+    sun's map covers the whole grid, a spot's cone a disc). A block spanning two surfaces gives two VPLs; the
+    grid's cell sets the plane tolerance."""
     prog = programs.compute("lpv/inject.glsl", {"MODE_LIST": 1})
     bind_grid(prog, grid)
 
@@ -129,7 +129,13 @@ def vpl_list(ctx, programs, rsm, shadows, grid: Grid, budget: int) -> VplList:
     k = 1
     while k < MAX_BLOCK and -(-rsm.size[0] // k) * -(-rsm.size[1] // k) > PRECLUSTER * budget:
         k *= 2  # cluster on the GPU first, so that the read-back stays a few times the budget
-    return _fitted(ctx, cluster(k), grid.cell / 2, k, budget)
+    return cluster(k), k
+
+
+def vpl_list(ctx, programs, rsm, shadows, grid: Grid, budget: int) -> VplList:
+    """The RSM as at most `budget` VPLs: rsm_records merged (`merge`) until they fit."""
+    records, k = rsm_records(ctx, programs, rsm, shadows, grid, budget)
+    return _fitted(ctx, records, grid.cell / 2, k, budget)
 
 
 def bounce_vpls(ctx, programs, state: LpvGridState, gv, budget: int) -> VplList:

@@ -19,13 +19,14 @@ def sky_flux_bound(grid: Grid, world_color) -> float:
     return math.pi * float(max(world_color[:3])) * border
 
 
-def inject(ctx, programs, rsm: Rsm, shadows, state: LpvGridState, world_color=(0.0, 0.0, 0.0),
+def inject(ctx, programs, rsm: Rsm | None, shadows, state: LpvGridState, world_color=(0.0, 0.0, 0.0),
            gv=None, downsample: int = 1, vpls: bool = True) -> float:
-    """RSM texels (unless not `vpls`) and world light at the open border → fixed-point SH sums → state.injected.
-    Returns the injected flux (W, sum of RGB)."""
+    """RSM texels (unless not `vpls`: then `rsm` may be None) and world light at the open border → fixed-point SH
+    sums → state.injected. Returns the injected flux (W, sum of RGB)."""
     grid = state.grid
     sky = max(world_color[:3]) > 0
-    scale = FIXED_RANGE / (rsm.flux_bound + (sky_flux_bound(grid, world_color) if sky else 0.0))
+    bound = (rsm.flux_bound if vpls else 0.0) + (sky_flux_bound(grid, world_color) if sky else 0.0)
+    scale = FIXED_RANGE / max(bound, 1e-30)
     state.accum_ints.clear()
     if vpls:
         prog = programs.compute("lpv/inject.glsl")

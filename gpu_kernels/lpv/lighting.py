@@ -16,8 +16,9 @@ def lighting(ctx, programs, gbuffer, states: list, gvs: list, settings: LpvSetti
     out.bind_to_image(0, read=False, write=True)
     unit = bind_named(prog, [("u_position", gbuffer.textures["position"]), ("u_normal", gbuffer.textures["normal"])])
     n = len(states)
-    per_cascade = {f"u_accum_{c}": [s.accum.textures()[i] for s in states] for i, c in enumerate("rgb")}
-    if flux_mode:
+    if not flux_mode:
+        per_cascade = {f"u_accum_{c}": [s.accum.textures()[i] for s in states] for i, c in enumerate("rgb")}
+    else:
         per_cascade = {"u_front": [s.front_total for s in states], "u_back": [s.back_total for s in states],
                        "u_voxel_normal": [g.normal for g in gvs]}
         fine_origin = [tuple(float(c) for c in g.fine.origin) for g in gvs]

@@ -26,6 +26,10 @@ class GeometryVolume:
     layers: object = None  # per LPV cell: where those planes lie (cells from the grid origin)
     surfaces: object = None  # storage buffer: (x, y, z, 0) int32 of every fine voxel holding a surface
     surface_count: int = 0
+    cells: np.ndarray | None = None  # (R, 3) xyz of those voxels, in the buffer's order
+    surface_normal: np.ndarray | None = None  # (R, 3) their mean normals (not renormalised)
+    surface_area: np.ndarray | None = None  # (R,) their surface areas (m²)
+    surface_albedo: np.ndarray | None = None  # (R, 3) their albedo, from the materials they were voxelised with
 
     def release(self):
         for t in (self.blocking, self.area, self.normal, self.albedo, self.coverage, self.layers, self.surfaces):
@@ -121,13 +125,14 @@ def geometry_volumes(ctx, programs, scene: Scene, geometry, textures, grids: lis
     for grid in grids:
         fine = Grid(tuple(np.asarray(grid.origin) - grid.cell / 2), grid.cell / 2, tuple(2 * n + 2 for n in grid.size))
         vox = voxelize(ctx, programs, scene, geometry, textures, fine)
-        area = vox.read()["area"]
+        arrays = vox.read()
+        area = arrays["area"]
         blocking = face_blocking(area, grid)
         tex = ctx.texture3d(tuple(n + 1 for n in grid.size), 4, np.ascontiguousarray(blocking).tobytes(), dtype="f4")
         for t in (tex, vox.area, vox.normal, vox.albedo):
             t.filter = (moderngl.NEAREST, moderngl.NEAREST)
         crossings = [ctx.texture3d(tuple(grid.size), 4, a.tobytes(), dtype="f4")
-                     for a in crossing_layers(area, vox.read()["normal"], grid)]
+                     for a in crossing_layers(area, arrays["normal"], grid)]
         for t in crossings:
             t.filter = (moderngl.NEAREST, moderngl.NEAREST)
         vox.emission.release()
@@ -136,8 +141,22 @@ def geometry_volumes(ctx, programs, scene: Scene, geometry, textures, grids: lis
         z, y, x = np.nonzero(area[..., 3] > 0)
         cells = np.stack([x, y, z, np.zeros_like(x)], axis=1).astype(np.int32)
         surfaces = ctx.buffer(cells.tobytes() if len(cells) else np.zeros(4, np.int32).tobytes())
-        out.append(GeometryVolume(tex, fine, vox.area, vox.normal, vox.albedo, *crossings, surfaces, len(cells)))
+        out.append(GeometryVolume(tex, fine, vox.area, vox.normal, vox.albedo, *crossings, surfaces, len(cells),
+                                  cells[:, :3], arrays["normal"][z, y, x, :3], area[z, y, x, 3],
+                                  arrays["albedo"][z, y, x, :3]))
     return out
+
+
+def surface_albedo(ctx, programs, scene: Scene, geometry, textures, gv: GeometryVolume) -> np.ndarray:
+    """(R, 3): the albedo of `gv`'s surface voxels under the scene's current materials — a voxelisation of the
+    same grid whose occupancy is discarded (a material edit changes no geometry: lpv/transfer.py)."""
+    from ..voxel.voxelize import voxelize
+
+    vox = voxelize(ctx, programs, scene, geometry, textures, gv.fine)
+    albedo = vox.read()["albedo"]
+    vox.release()
+    x, y, z = gv.cells.T
+    return albedo[z, y, x, :3]
 
 
 def absorb(ctx, programs, state: LpvGridState, gv: GeometryVolume, add: bool) -> None:

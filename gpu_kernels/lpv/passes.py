@@ -7,13 +7,28 @@
     lpv_propagate    ← injection, geometry volume, LPV settings (the transport: gather.gather_all or
                        propagate.propagate_all; with octree levels, octree.py's passes)
     lpv_lighting     ← gbuffer, transport
+
+With the cached transport (transport = "transfer", lpv/transfer.py) the geometry volume is keyed by geometry
+alone and the passes are instead:
+
+    geometry_volume      ← geometry, grids                    (occupancy, normals, visibility planes)
+    lpv_albedo           ← geometry volume, materials          (the surface voxels' albedo)
+    lpv_transfer         ← geometry volume, budget             (clusters and the kernel T: the expensive part)
+    lpv_transfer_albedo  ← transfer, albedo                    (M_ρ: cluster-to-cluster reflection)
+    lpv_world            ← geometry volume, world, settings    (the world light, propagated and absorbed)
+    lpv_inject           ← rsm, transfer                       (the RSM's flux per cluster)
+    lpv_propagate        ← all of the above, bounces           (the bounce series and one product with T)
+    lpv_lighting         ← gbuffer, transport
 """
 from __future__ import annotations
 
+import numpy as np
+
 from ..common.method import MethodOutput
 from ..scene import hash_parts
-from . import gather, inject, lighting, occlusion, octree, propagate, rsm
-from .state import cascade_grids
+from ..voxel.voxelize import scene_area
+from . import clusters, gather, inject, lighting, occlusion, octree, propagate, rsm, transfer
+from .state import LpvGridState, cascade_grids
 
 
 def run(frame) -> MethodOutput:
@@ -24,6 +39,9 @@ def run(frame) -> MethodOutput:
     k_rsm = (frame.keys["shadow"], s.rsm_resolution)
     maps = cache.run("rsm", k_rsm, lambda: rsm.render_rsm(ctx, programs, scene, frame.geometry, frame.textures,
                                                            frame.shadows, s.rsm_resolution))
+    budget = transfer_budget(scene, grids, s)
+    if budget:
+        return _transfer(frame, grids, k_grids, maps, k_rsm, budget)
     k_gv = (frame.keys["geometry"], frame.keys["materials"], k_grids, s.occlusion)
     gvs = cache.run("geometry_volume", k_gv, lambda: occlusion.geometry_volumes(
         ctx, programs, scene, frame.geometry, frame.textures, grids) if s.occlusion else [None] * len(grids))
@@ -54,3 +72,107 @@ def _octree(frame, states, gvs, grids, k_gv, k_inject, k_prop):
     stats = cache.run("lpv_propagate", k_prop, lambda: octree.propagate_levels(ctx, programs, tree, geo, s))
     merged = cache.run("lpv_merge", k_prop, lambda: octree.merge(ctx, programs, tree, geo))
     return [merged], [None], stats, octree.lookup_settings(s)
+
+
+def surface_voxels(scene, grids) -> float:
+    """About how many fine voxels the scene's surfaces occupy: 1.5 per fine cell² of area (planes at an angle to
+    the grid touch more than one voxel per cell)."""
+    return 1.5 * scene_area(scene) / min(g.cell / 2 for g in grids) ** 2
+
+
+def transfer_budget(scene, grids, s) -> int:
+    """Clusters per cascade for the cached transport, or 0 where it does not apply or would not fit `transfer_mb`
+    (T holds 2 × clusters × surface voxels float32)."""
+    if s.transport != "transfer" or not s.gathers:
+        return 0
+    budget = min(s.gather_vpls, int(s.transfer_mb * 2 ** 20 / (8 * max(surface_voxels(scene, grids), 1.0))))
+    return budget if budget >= transfer.MIN_CLUSTERS else 0
+
+
+def transfer_estimate(scene, s) -> dict:
+    """What the cached transport would hold at these settings, from the surface area (no GPU work): surface voxels,
+    clusters and MiB of T per cascade, or that it gathers instead."""
+    grids = cascade_grids(scene, s)
+    voxels = surface_voxels(scene, grids)
+    budget = transfer_budget(scene, grids, s)
+    return {"resolution": s.resolution, "surface_voxels": int(voxels), "clusters": budget,
+            "mb": 8 * budget * voxels / 2 ** 20, "transport": "transfer" if budget else "gather"}
+
+
+def _transfer(frame, grids, k_grids, maps, k_rsm, budget) -> MethodOutput:
+    """The cached transport's passes (lpv/transfer.py); see the module docstring for what each reads."""
+    ctx, programs, cache, scene, s = frame.ctx, frame.programs, frame.cache, frame.scene, frame.settings.lpv
+    materials = frame.keys["materials"]
+    k_gv = (frame.keys["geometry"], k_grids, "geometry only")
+
+    def volumes():
+        gvs = occlusion.geometry_volumes(ctx, programs, scene, frame.geometry, frame.textures, grids)
+        for gv in gvs:
+            gv.materials_key = materials  # whose albedo gv.surface_albedo holds
+        return gvs
+    gvs = cache.run("geometry_volume", k_gv, volumes)
+    k_albedo = (k_gv, materials)
+    albedo = cache.run("lpv_albedo", k_albedo, lambda: [
+        gv.surface_albedo if gv.materials_key == materials else
+        occlusion.surface_albedo(ctx, programs, scene, frame.geometry, frame.textures, gv) for gv in gvs])
+    k_tr = (k_gv, budget, s.occlusion)
+    transfers = cache.run("lpv_transfer", k_tr, lambda: [_build(ctx, programs, gv, grid, budget, s)
+                                                         for gv, grid in zip(gvs, grids)])
+    weights = [a * gv.surface_area[:, None] for a, gv in zip(albedo, gvs)]
+    k_m = (k_tr, k_albedo)
+    m_rho = cache.run("lpv_transfer_albedo", k_m, lambda: [
+        transfer.albedo_transfer(t, w) for t, w in zip(transfers, weights)])
+    world = tuple(float(c) for c in scene.world.color[:3])
+    k_world = (k_gv, world, s.max_iterations, s.epsilon, s.clamp_negative)
+    worlds = cache.run("lpv_world", k_world, lambda: [_world(ctx, programs, gv, grid, world, s)
+                                                      for gv, grid in zip(gvs, grids)])
+    k_src = (k_rsm, k_tr)
+    sources = cache.run("lpv_inject", k_src, lambda: [clusters.bin_flux(t.clusters, gather.rsm_records(
+        ctx, programs, maps, frame.shadows, grid, budget)[0]) for t, grid in zip(transfers, grids)])
+    k_prop = (k_src, k_m, k_world, s.bounces, s.epsilon)
+    solved = cache.run("lpv_propagate", k_prop, lambda: _solve(ctx, gvs, grids, transfers, m_rho, weights, worlds,
+                                                               sources, s))
+    k_light = (frame.keys["gbuffer"], k_prop)
+    indirect = cache.run("lpv_lighting", k_light,
+                         lambda: lighting.lighting(ctx, programs, frame.gbuffer, solved["surfaces"], gvs, s))
+    return MethodOutput(indirect, None, k_light, {"cascades": solved["stats"]})
+
+
+def _build(ctx, programs, gv, grid, budget, s) -> transfer.Transfer:
+    """Clusters and T of one cascade; the budget re-checked against its real surface-voxel count."""
+    fits = int(s.transfer_mb * 2 ** 20 / (8 * max(gv.surface_count, 1)))
+    sources = clusters.make_clusters(gv.cells, gv.surface_normal, gv.surface_area, gv.fine,
+                                     max(transfer.MIN_CLUSTERS, min(budget, fits)))
+    matrix = transfer.build_transfer(ctx, programs, gv, grid, sources, s.occlusion)
+    return transfer.sort_by_cluster(sources, matrix)
+
+
+def _world(ctx, programs, gv, grid, world, s):
+    """The world light's irradiance on the surface voxels, (2, R, 3), propagated in from the open border and
+    absorbed as in gather.gather_all; None under a black world (nothing runs)."""
+    if max(world) <= 0:
+        return None
+    state = LpvGridState(ctx, grid)
+    try:
+        state.injected_flux = inject.inject(ctx, programs, None, None, state, world, gv, vpls=False)
+        state.face_flux.clear()
+        propagate.propagate(ctx, programs, state, state.injected, state.injected_flux, gv.blocking, s,
+                            accumulate=False)
+        occlusion.absorb(ctx, programs, state, gv, add=False)
+        return transfer.read_sides(state, gv.cells)
+    finally:
+        state.release()
+
+
+def _solve(ctx, gvs, grids, transfers, m_rho, weights, worlds, sources, s) -> dict:
+    """Each cascade's bounce series (transfer.solve), uploaded for the flux lookup, and its statistics."""
+    surfaces, stats = [], []
+    for gv, grid, t, m, w, world, (first, unbinned) in zip(gvs, grids, transfers, m_rho, weights, worlds, sources):
+        sides, passes = transfer.solve(t, m, w, first, world, s.bounces, s.epsilon)
+        valid = (gv.surface_area > 0) & (np.linalg.norm(gv.surface_normal, axis=1) > 0)
+        surfaces.append(transfer.upload_sides(ctx, grid, gv.fine, gv.cells, valid, sides))
+        stats.append({"cells": list(grid.size), "cell": grid.cell, "transport": "transfer",
+                      "clusters": t.clusters.count, "block": t.clusters.block, "transfer_mb": t.nbytes / 2 ** 20, "injected_flux": float(first.sum()),
+                      "escaped_flux": unbinned, "world": world is not None,
+                      "bounces": [{"flux": f} for f in passes], "bounces_used": len(passes)})
+    return {"surfaces": surfaces, "stats": stats}

@@ -56,13 +56,26 @@ def flux_bound(buffers: lb.LightBuffers) -> float:
     return max(total, 1e-12)
 
 
+def view_resolution(resolution: int, ortho: bool, samples: int) -> int:
+    """Texels per side of one RSM view: `resolution` (a sun's map twice that). A light sampled from several points
+    (an area light's samples, each its own view of the same surfaces) splits its flux between them, and each of
+    its texels' flux loops over every sample (lpv/inject.glsl); so each view gets 1/samples of the side, which
+    keeps the light's work about one view's worth — the views together still cover its surfaces densely. A
+    multiple of 16 (lpv/inject.glsl's blocks never straddle views)."""
+    side = resolution * (2 if ortho else 1)
+    if samples > 1:
+        side = max(16, 16 * round(side / samples / 16))
+    return side
+
+
 def render_rsm(ctx, programs, scene: Scene, geometry, textures, shadows, resolution: int) -> Rsm:
     """Render every shadow view of every light once more as an RSM (position, normal, albedo) into an atlas."""
     import moderngl
 
     buffers = shadows.buffers
     views = buffers.views
-    res = [resolution * (2 if v.ortho else 1) for v in views]
+    res = [view_resolution(resolution, v.ortho, int(buffers.lights[light]["params"][2]))
+           for v, light in zip(views, buffers.view_lights)]
     tiles, size, scale = lb.allocate_atlas(res, max_height=ctx.info.get("GL_MAX_TEXTURE_SIZE", 16384))
     targets = [ctx.texture(size, 4, dtype="f4") for _ in range(3)]
     for t in targets:
@@ -91,6 +104,6 @@ def render_rsm(ctx, programs, scene: Scene, geometry, textures, shadows, resolut
         records[i]["params"] = (0.0 if view.ortho else view.half_extent,
                                 2 * view.half_extent / w if view.ortho else 0.0, light, k)
         records[i]["origin"] = (*view.origin, 1.0 if view.ortho else 0.0)
-        records[i]["axis"] = (*-back, 0.0)
+        records[i]["axis"] = (*-back, float(w))  # w: texels per side of this view
         records[i]["right"] = (*right, 0.0)
     return Rsm(*targets, ssbo(ctx, records), size, resolution // scale, flux_bound(buffers), vao, fbo, depth)

@@ -32,8 +32,12 @@ class LpvSettings:
     # LPV. World light propagates either way. The gather writes surface voxels' irradiance, which only the flux
     # lookup with occlusion reads: the intensity lookup, occlusion=False and the octree always propagate (see
     # `gathers`). `gather_vpls` bounds the VPLs per bounce: RSM texels and surface voxels are clustered to fit.
-    transport: str = "gather"
+    # "transfer" is the gather with its sources fixed per geometry and the kernel cached (lpv/transfer.py): an
+    # edit of lights, materials or world re-runs no visibility; `transfer_mb` bounds the cache (MiB per cascade),
+    # past which it gathers.
+    transport: str = "transfer"
     gather_vpls: int = 512
+    transfer_mb: int = 512
 
     def __post_init__(self):
         if not 4 <= self.resolution <= 256:
@@ -42,8 +46,10 @@ class LpvSettings:
             raise ValueError(f"cascades {self.cascades} out of range 1..4")
         if self.lookup not in ("flux", "intensity"):
             raise ValueError(f"lookup must be 'flux' or 'intensity', not {self.lookup!r}")
-        if self.transport not in ("gather", "propagate"):
-            raise ValueError(f"transport must be 'gather' or 'propagate', not {self.transport!r}")
+        if self.transport not in ("transfer", "gather", "propagate"):
+            raise ValueError(f"transport must be 'transfer', 'gather' or 'propagate', not {self.transport!r}")
+        if self.transfer_mb < 1:
+            raise ValueError(f"transfer_mb {self.transfer_mb} must be ≥ 1")
         if self.gathered_bounces < 0:
             raise ValueError(f"gathered_bounces {self.gathered_bounces} must be ≥ 0 (0: gather every bounce)")
         if not 16 <= self.gather_vpls <= 65536:
@@ -61,6 +67,6 @@ class LpvSettings:
 
     @property
     def gathers(self) -> bool:
-        """Whether light is gathered (transport="gather" where the flux lookup reads it)."""
-        return (self.transport == "gather" and self.lookup == "flux" and self.occlusion
+        """Whether light is gathered (transport "gather" or "transfer" where the flux lookup reads it)."""
+        return (self.transport in ("gather", "transfer") and self.lookup == "flux" and self.occlusion
                 and not self.octree_levels)

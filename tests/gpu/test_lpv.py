@@ -107,7 +107,7 @@ def test_transfer_matrices_match_the_face_loop(engine):
     assert np.allclose(a, b, rtol=1e-5)
 
 
-@pytest.mark.parametrize("transport", ["gather", "propagate"])
+@pytest.mark.parametrize("transport", ["transfer", "gather", "propagate"])
 def test_closed_sphere_one_bounce_against_the_analytic_irradiance(engine, transport):
     """Inside a closed sphere of albedo ρ with a point light of flux Φ at its centre, the one-bounce indirect
     irradiance is uniform, E₁ = ρΦ/(4πR²) (every pair of points on a sphere has the same form factor).
@@ -127,7 +127,7 @@ def test_closed_sphere_one_bounce_against_the_analytic_irradiance(engine, transp
     ratio = irradiance.mean() / e1
     print(f"sphere ({transport}): mean E/E1 {ratio:.3f}, min {irradiance.min() / e1:.3f}, "
           f"max {irradiance.max() / e1:.3f}")
-    if transport == "gather":
+    if transport != "propagate":  # the transfer is the gather from fixed clusters: the same claim
         assert ratio == pytest.approx(1.0, abs=0.15)
         assert irradiance.min() > 0.9 * irradiance.mean() and irradiance.max() < 1.1 * irradiance.mean()
     else:

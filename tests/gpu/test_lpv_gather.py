@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""The LPV's gathered transport (gpu_kernels/lpv/gather.py, the default): VPLs → surface voxels with fuzzy
-visibility, bounce by bounce, with the extrapolated tail. Exact oracles: the closed sphere's bounce series, a lit
+"""The LPV's gathered transports: "gather" (gpu_kernels/lpv/gather.py: VPLs → surface voxels with fuzzy
+visibility, bounce by bounce, with the extrapolated tail) and "transfer" (lpv/transfer.py, the default: the same
+kernel from fixed clusters, cached, every bounce summed). Exact oracles: the closed sphere's bounce series, a lit
 patch's view factor, a closed partition; and the clustering's flux bookkeeping.
 """
 import math
@@ -51,21 +52,27 @@ def test_merging_keeps_the_flux_and_keeps_floor_and_wall_apart():
 
 
 def test_the_vpl_list_carries_the_injected_flux(engine):
-    """The gather's VPLs (clustered to fit `gather_vpls`) and the propagation's injection read the same RSM: the
-    same flux, whatever the budget (float32 sums: 1e-4; measured 152.573 W for all three)."""
+    """The gather's VPLs (clustered to fit `gather_vpls`), the transfer's clusters and the propagation's
+    injection read the same RSM: the same flux, whatever the budget (float32 sums: 1e-4; inside a closed sphere
+    none escapes)."""
     scene = _sphere_scene()
     propagated = _render(engine, scene, transport="propagate", bounces=1, max_iterations=4)
     flux = [propagated.info["cascades"][0]["injected_flux"]]
     for budget in (64, 512):
-        r = _render(engine, scene, bounces=1, gather_vpls=budget)
+        r = _render(engine, scene, bounces=1, gather_vpls=budget, transport="gather")
         assert r.info["cascades"][0]["bounces"][0]["vpls"] <= budget
         flux.append(r.info["cascades"][0]["injected_flux"])
-    print("injected flux, propagate / gather 64 / gather 512:", flux)
-    assert flux[1] == pytest.approx(flux[0], rel=1e-4) and flux[2] == pytest.approx(flux[0], rel=1e-4)
+        t = \
+            _render(engine, scene, bounces=1, gather_vpls=budget).info["cascades"][0]
+        assert t["transport"] == "transfer" and t["clusters"] <= budget and t["escaped_flux"] == 0
+        flux.append(t["injected_flux"])
+    print("injected flux, propagate / gather 64 / transfer 64 / gather 512 / transfer 512:", flux)
+    assert flux[1:] == pytest.approx([flux[0]] * 4, rel=1e-4)
 
 
-@pytest.mark.parametrize("bounces,gathered", [(3, 0), (8, 4)])
-def test_closed_sphere_bounce_series_against_the_analytic_irradiance(engine, bounces, gathered):
+@pytest.mark.parametrize("transport,bounces,gathered", [("gather", 3, 0), ("gather", 8, 4), ("transfer", 3, 0),
+                                                        ("transfer", 8, 0)])
+def test_closed_sphere_bounce_series_against_the_analytic_irradiance(engine, transport, bounces, gathered):
     """Inside a closed sphere of albedo ρ with a point light of flux Φ, every bounce is uniform and each is ρ times
     the last: E = E₁·(1 − ρᴺ)/(1 − ρ), E₁ = ρΦ/(4πR²). Three bounces all gathered, and the default (8 bounces, 4
     gathered, 4 extrapolated from the flux ratio of the last two, which should come out ρ). Measured at 32³:
@@ -73,14 +80,16 @@ def test_closed_sphere_bounce_series_against_the_analytic_irradiance(engine, bou
     1 bounce 1.005·E₁ (the issue's ±15% test, test_lpv.py). Bounds: mean within 10%, every pixel within ±25% of
     the mean (the series is uniform; the spread is the gather's quadrature), ratio within 8% of ρ — each gather
     from voxel clusters delivers ~95% of their light here (their centroids are voxel centres, off the surface by
-    up to half a voxel, and receivers in a cluster's own plane are skipped), which the ratio measures."""
+    up to half a voxel, and receivers in a cluster's own plane are skipped), which the ratio measures.
+    The transfer sums every bounce (`gathered` does not apply) with the same kernel and the same bounds."""
     rho = 0.5
-    r = _render(engine, _sphere_scene(subdivisions=4), resolution=32, bounces=bounces, gathered_bounces=gathered)
+    r = _render(engine, _sphere_scene(subdivisions=4), resolution=32, bounces=bounces, gathered_bounces=gathered,
+                transport=transport)
     e1 = rho * 100.0 / (4 * math.pi)
     expected = e1 * (1 - rho ** bounces) / (1 - rho)
     irradiance = r.passes["Diffuse Indirect"][..., 0] * math.pi
     stats = r.info["cascades"][0]["bounces"]
-    print(f"sphere, {bounces} bounces ({gathered or 'all'} gathered): mean E / expected "
+    print(f"sphere, {transport} {bounces} bounces ({gathered or 'all'} gathered): mean E / expected "
           f"{irradiance.mean() / expected:.3f}, min {irradiance.min() / expected:.3f}, "
           f"max {irradiance.max() / expected:.3f}; passes {stats}")
     assert irradiance.mean() == pytest.approx(expected, rel=0.10)
@@ -90,22 +99,24 @@ def test_closed_sphere_bounce_series_against_the_analytic_irradiance(engine, bou
         assert stats[-1]["ratio"][0] == pytest.approx(rho, rel=0.08)
 
 
+@pytest.mark.parametrize("transport", ["gather", "transfer"])
 @pytest.mark.parametrize("receiver", ["plate above", "wall beside"])
-def test_a_lit_patch_in_a_dark_floor_matches_its_view_factor(engine, receiver):
+def test_a_lit_patch_in_a_dark_floor_matches_its_view_factor(engine, receiver, transport):
     """test_vct.py's case for the LPV: a 3 × 2.5 m sunlit patch in a black 6 × 6 m floor, seen from a plate 3 m
     above and a wall 1.5 m beside it. One bounce; exact answer by quadrature. Measured (32³): plate 1.031 of the
     exact mean (per-pixel rel-L1 0.031), wall 1.033 (0.033). Bounds: mean within 10%, rel-L1 below 0.20 — the
     patch's edges are resolved to a fine voxel (9.8 cm here) and its light reaches the receivers from at most
     512 VPL clusters."""
-    r = _render(engine, lit_patch_scene(receiver), resolution=32, bounces=1)
+    r = _render(engine, lit_patch_scene(receiver), resolution=32, bounces=1, transport=transport)
     ratio, rel_l1, pixels = lit_patch_error(r.passes)
     assert pixels > 50
-    print(f"{receiver}: ours / exact view factor {ratio:.3f}, rel-L1 {rel_l1:.3f} over {pixels} pixels")
+    print(f"{receiver} ({transport}): ours / exact view factor {ratio:.3f}, rel-L1 {rel_l1:.3f} over {pixels} pixels")
     assert ratio == pytest.approx(1.0, abs=0.10)
     assert rel_l1 < 0.20
 
 
-def test_a_closed_partition_stops_the_gathered_light(engine):
+@pytest.mark.parametrize("transport", ["gather", "transfer"])
+def test_a_closed_partition_stops_the_gathered_light(engine, transport):
     """Two 2 × 2 × 2 m rooms side by side, a closed 10 cm partition between them (thinner than a cell, 13.8 cm
     here), a point light in the left one: no light can reach the right room (Cycles: exactly 0). The gather's
     visibility meets the partition's planes. Measured: the dark room gets 0.03% (1 bounce) / 0.04% (3 bounces) of
@@ -117,8 +128,9 @@ def test_a_closed_partition_stops_the_gathered_light(engine):
                                                                  [0, 0, 0, 1]]))]
     means = []
     for eye, target in (((-1.9, 0.0, 1.0), (0.0, 0.0, 0.8)), ((1.9, 0.0, 1.0), (0.0, 0.0, 0.8))):
-        r = _render(engine, quad_scene(quads, mats, light, eye, target, lens=12.0), resolution=32, bounces=3)
+        r = _render(engine, quad_scene(quads, mats, light, eye, target, lens=12.0), resolution=32, bounces=3,
+                    transport=transport)
         means.append(float(r.passes["Diffuse Indirect"][..., 0].mean()))
-    print(f"mean Diffuse Indirect, lit room {means[0]:.4f}, dark room {means[1]:.6f} ({means[1] / means[0]:.3%})")
+    print(f"{transport}: mean Diffuse Indirect, lit room {means[0]:.4f}, dark room {means[1]:.6f} ({means[1] / means[0]:.3%})")
     assert means[0] > 0
     assert means[1] < 0.01 * means[0]

@@ -18,6 +18,8 @@
 // covered fractions of the surface planes the ray crosses, summed, T = max(0, 1 − their sum) (a face half
 // covered lets half through, as in propagation; see transmittance).
 //
+// MODE_TRANSFER writes the kernel per receiver and source instead (lpv/transfer.py: the cached transport).
+//
 // The result is added, per side, to what lpv/absorb.glsl found (world light, which still propagates), so the flux
 // lookup (lpv/lighting.glsl, MODE_FLUX) reads it unchanged; the next bounce's VPLs come from it (lpv/cluster.glsl).
 #include "lpv/common.glsl"
@@ -38,10 +40,14 @@ uniform vec3 u_fine_origin;
 uniform vec3 u_grid_origin;
 uniform float u_grid_cell;
 uniform ivec3 u_grid_size;
+#if defined(MODE_TRANSFER)
+layout(std430, binding = 8) writeonly buffer Transfer { vec2 transfer[]; };  // lpv/transfer.py
+#else
 layout(rgba32f, binding = 0) uniform image3D u_front;  // this bounce: rgb irradiance (W/m²), a = 1 if surface
 layout(rgba32f, binding = 1) uniform image3D u_back;
 layout(rgba32f, binding = 2) uniform image3D u_front_total;
 layout(rgba32f, binding = 3) uniform image3D u_back_total;
+#endif
 
 const float PI = 3.14159265358979;
 const float END_CELLS = 0.5;
@@ -97,55 +103,71 @@ float transmittance(vec3 from, vec3 dir, float dist) {
     return 1.0 - crossings;
 }
 
+// What a VPL of unit flux gives a receiver voxel at p (normal nv) per side: (front, back) irradiance per watt, so
+// that E = Φ · kernel. Linear in Φ: the transfer (MODE_TRANSFER) stores it per receiver and source.
+vec2 vpl_kernel(Vpl v, vec3 p, vec3 nv, float h) {
+    vec3 nl = v.normal.xyz;
+    vec3 d = p - v.position.xyz;
+    // Height above the VPL's plane: ≤ 0 behind it (no light); under half a voxel (its box's extent along the
+    // normal), the voxel holds the VPL's own surface — or the other side of a slab thinner than a voxel — and
+    // its centre is off the surface by up to half a voxel, which would light the back of a surface with its
+    // own front (a roof's underside with its sunlit top): skip it too.
+    float height = dot(nl, d);
+    if (height < 0.5 * h * dot(abs(nl), vec3(1.0))) return vec2(0.0);
+    float d2 = dot(d, d);
+    float dist = sqrt(d2);
+    vec3 w = d / dist;
+    float receive = dot(nv, -w);  // > 0: the VPL is on the voxel's front side (as in lpv/absorb.glsl)
+    float source_area = max(PI * h * h, v.normal.w);
+    float t = transmittance(v.position.xyz, w, dist);
+    if (t <= 0.0) return vec2(0.0);
+    if (d2 > NEAR_FIELD * source_area / PI) {
+        float e = height / dist * abs(receive) * t / (PI * d2 + source_area);
+        return receive > 0.0 ? vec2(e, 0.0) : vec2(0.0, e);
+    }
+    // Near a cluster (within 3 of its disc radii) its centroid is a poor stand-in — at a corner the
+    // centroid sits level with a receiver its nearer part faces: four quarter discs, at their centroids
+    // (0.6 radii out along the diagonals), each with a quarter of the flux and area. Visibility: the centroid's.
+    vec3 t1 = normalize(abs(nl.x) < 0.9 ? cross(nl, vec3(1.0, 0.0, 0.0)) : cross(nl, vec3(0.0, 1.0, 0.0)));
+    vec3 t2 = cross(nl, t1);
+    float r = 0.6 * 0.70710678 * sqrt(source_area / PI);
+    vec2 k = vec2(0.0);
+    for (int q = 0; q < 4; ++q) {
+        vec3 ds = d - r * ((q & 1) == 0 ? t1 : -t1) - r * ((q & 2) == 0 ? t2 : -t2);
+        float s2 = dot(ds, ds);
+        vec3 ws = ds * inversesqrt(s2);
+        float rs = dot(nv, -ws);
+        float e = 0.25 * dot(nl, ws) * abs(rs) * t / (PI * s2 + 0.25 * source_area);
+        if (rs > 0.0) k.x += e; else k.y += e;
+    }
+    return k;
+}
+
 void main() {
     if (int(gl_GlobalInvocationID.x) >= u_surface_count) return;
     ivec3 f = surfaces[gl_GlobalInvocationID.x].xyz;
     vec4 area = texelFetch(u_voxel_area, f, 0);
     vec3 nv = texelFetch(u_voxel_normal, f, 0).xyz;
-    if (area.a <= 0.0 || dot(nv, nv) == 0.0) return;
-    nv = normalize(nv);
+    bool receives = area.a > 0.0 && dot(nv, nv) > 0.0;
+    nv = receives ? normalize(nv) : vec3(0.0, 0.0, 1.0);
     float h = 0.5 * u_grid_cell;
     vec3 p = u_fine_origin + (vec3(f) + 0.5) * h;
+#if defined(MODE_TRANSFER)
+    // One row per source of this dispatch: transfer[(j − first) · surfaces + receiver] = (front, back).
+    for (int j = u_vpl_first; j < u_vpl_first + u_vpl_count; ++j)
+        transfer[(j - u_vpl_first) * u_surface_count + int(gl_GlobalInvocationID.x)] =
+            receives ? vpl_kernel(vpls[j], p, nv, h) : vec2(0.0);
+#else
+    if (!receives) return;
     vec3 front = vec3(0.0), back = vec3(0.0);
     for (int j = u_vpl_first; j < u_vpl_first + u_vpl_count; ++j) {
-        Vpl v = vpls[j];
-        vec3 nl = v.normal.xyz;
-        vec3 d = p - v.position.xyz;
-        // Height above the VPL's plane: ≤ 0 behind it (no light); under half a voxel (its box's extent along the
-        // normal), the voxel holds the VPL's own surface — or the other side of a slab thinner than a voxel — and
-        // its centre is off the surface by up to half a voxel, which would light the back of a surface with its
-        // own front (a roof's underside with its sunlit top): skip it too.
-        float height = dot(nl, d);
-        if (height < 0.5 * h * dot(abs(nl), vec3(1.0))) continue;
-        float d2 = dot(d, d);
-        float dist = sqrt(d2);
-        vec3 w = d / dist;
-        float receive = dot(nv, -w);  // > 0: the VPL is on the voxel's front side (as in lpv/absorb.glsl)
-        float source_area = max(PI * h * h, v.normal.w);
-        float t = transmittance(v.position.xyz, w, dist);
-        if (t <= 0.0) continue;
-        if (d2 > NEAR_FIELD * source_area / PI) {
-            vec3 e = v.flux.rgb * (height / dist * abs(receive) * t / (PI * d2 + source_area));
-            if (receive > 0.0) front += e; else back += e;
-            continue;
-        }
-        // Near a cluster (within 3 of its disc radii) its centroid is a poor stand-in — at a corner the
-        // centroid sits level with a receiver its nearer part faces: four quarter discs, at their centroids
-        // (0.6 radii out along the diagonals), each with a quarter of the flux and area. Visibility: the centroid's.
-        vec3 t1 = normalize(abs(nl.x) < 0.9 ? cross(nl, vec3(1.0, 0.0, 0.0)) : cross(nl, vec3(0.0, 1.0, 0.0)));
-        vec3 t2 = cross(nl, t1);
-        float r = 0.6 * 0.70710678 * sqrt(source_area / PI);
-        for (int q = 0; q < 4; ++q) {
-            vec3 ds = d - r * ((q & 1) == 0 ? t1 : -t1) - r * ((q & 2) == 0 ? t2 : -t2);
-            float s2 = dot(ds, ds);
-            vec3 ws = ds * inversesqrt(s2);
-            float rs = dot(nv, -ws);
-            vec3 e = v.flux.rgb * (0.25 * dot(nl, ws) * abs(rs) * t / (PI * s2 + 0.25 * source_area));
-            if (rs > 0.0) front += e; else back += e;
-        }
+        vec2 k = vpl_kernel(vpls[j], p, nv, h);
+        front += vpls[j].flux.rgb * k.x;
+        back += vpls[j].flux.rgb * k.y;
     }
     imageStore(u_front, f, vec4(imageLoad(u_front, f).rgb + front, 1.0));
     imageStore(u_back, f, vec4(imageLoad(u_back, f).rgb + back, 1.0));
     imageStore(u_front_total, f, vec4(imageLoad(u_front_total, f).rgb + front, 1.0));
     imageStore(u_back_total, f, vec4(imageLoad(u_back_total, f).rgb + back, 1.0));
+#endif
 }

@@ -14,7 +14,6 @@ uniform sampler2D u_rsm_position;
 uniform sampler2D u_rsm_normal;
 uniform sampler2D u_rsm_albedo;
 uniform ivec2 u_rsm_size;
-uniform int u_rsm_resolution;     // texels per RSM view side
 uniform int u_downsample;         // k: each k×k block of texels becomes one VPL (Kaplanyan 2009, §N.5.2)
 uniform vec3 u_grid_origin;
 uniform float u_grid_cell;
@@ -23,7 +22,7 @@ uniform ivec3 u_grid_size;
 struct RsmView {
     vec4 params;   // x: tan(half fov) (perspective) or 0; y: texel world size (orthographic); z: light; w: sample k
     vec4 origin;   // xyz eye (perspective); w: 1 if orthographic
-    vec4 axis;     // xyz view axis; w: unused
+    vec4 axis;     // xyz view axis; w: texels per side of this view (lpv/rsm.view_resolution)
     vec4 right;    // xyz right vector of the view; w: unused (with axis and up: tangent-plane coordinates)
 };
 layout(std430, binding = 3) readonly buffer RsmViewBuffer { RsmView rsm_views[]; };
@@ -40,7 +39,7 @@ float texel_solid_angle(RsmView v, vec3 p) {
     float z = dot(d, v.axis.xyz);
     vec3 up = cross(v.right.xyz, v.axis.xyz);
     float x = dot(d, v.right.xyz) / z, y = dot(d, up) / z;
-    float t = 2.0 * v.params.x / float(u_rsm_resolution);
+    float t = 2.0 * v.params.x / v.axis.w;
     return t * t / pow(1.0 + x * x + y * y, 1.5);
 }
 

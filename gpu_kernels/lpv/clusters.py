@@ -1,0 +1,207 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""The cached LPV transport's sources (lpv/transfer.py): the surface voxels' sides grouped, once per geometry, into
+clusters — S×S×S blocks of fine voxels, split by the dominant axis of each side's normal (a floor and the wall
+beside it stay apart), by plane (a rug and the floor under it) and by connectivity (two rooms' floors in one
+block, on either side of a partition) — with area-weighted positions and normals. Sides with the whole scene
+behind them get none. And the RSM's VPL flux binned into them (bin_flux): each watt kept or counted as escaped.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..common.grid import Grid
+from .gather import VPL_DTYPE
+
+
+@dataclass
+class Clusters:
+    """Geometry-only sources: which cluster each surface voxel's front / back side belongs to, and each cluster's
+    VPL record (area-weighted centroid of its voxels' centres, mean side normal, w = total area). Clusters are
+    numbered in order of (block and side key, plane offset)."""
+    block: int  # S: fine voxels per block side
+    side_cluster: np.ndarray  # (R, 2) int: cluster of the front / back side, −1 where it emits nowhere
+    records: np.ndarray  # (C,) VPL_DTYPE, flux 0
+    key: np.ndarray  # (C,) block index × 6 + side (side_of) of each cluster, ascending
+    offsets: np.ndarray  # (C, 2) min / max plane offset n·x (m) of its voxels' centres
+    box: np.ndarray  # (C, 2, 3) min / max corner of its voxels' centres
+    fine: Grid
+    lo: np.ndarray  # the surface voxels' centres' bounding box (faces_something)
+    hi: np.ndarray
+
+    @property
+    def count(self) -> int:
+        return len(self.records)
+
+
+def side_of(normals: np.ndarray) -> np.ndarray:
+    """0..5: the dominant axis of each normal and its sign (+x, −x, +y, −y, +z, −z)."""
+    axis = np.argmax(np.abs(normals), axis=1)
+    return 2 * axis + (normals[np.arange(len(normals)), axis] < 0)
+
+
+def block_keys(points: np.ndarray, normals: np.ndarray, fine: Grid, block: int) -> np.ndarray:
+    """Block index × 6 + side of oriented points (world positions, unit normals)."""
+    size = np.asarray(fine.size)
+    f = np.clip(np.floor((points - np.asarray(fine.origin)) / fine.cell).astype(np.int64), 0, size - 1)
+    b = f // block
+    blocks = -(-size // block)
+    return ((b[:, 2] * blocks[1] + b[:, 1]) * blocks[0] + b[:, 0]) * 6 + side_of(normals)
+
+
+def faces_something(points: np.ndarray, normals: np.ndarray, lo: np.ndarray, hi: np.ndarray, h: float) -> np.ndarray:
+    """Whether any of the box [lo, hi] lies in front of each oriented point by more than the kernel's own-surface
+    height (lpv/gather.glsl: ½ h·|n|₁) plus a voxel: a side with the whole scene behind it — the outside of a
+    room's boundary walls, a roof's top — sends light to no receiver, so it needs no source (or column of T)."""
+    corner = np.where(normals > 0, hi, lo)  # the box's support point along each normal
+    reach = np.einsum("ij,ij->i", normals, corner - points)
+    return reach > h * (0.5 * np.abs(normals).sum(axis=1) + 1.0)
+
+
+def _absorb_small(piece: np.ndarray, parent: np.ndarray, smallest: int) -> np.ndarray:
+    """Pieces (labels per side) of fewer than `smallest` sides join the largest piece of their `parent` group —
+    an edge voxel whose normal leans away from its neighbours' is no surface of its own."""
+    sizes = np.bincount(piece)
+    largest = np.full(int(parent.max(initial=-1)) + 1, -1)
+    by_size = np.lexsort((sizes[piece], parent))  # per parent, ascending size: the last one written wins
+    largest[parent[by_size]] = piece[by_size]
+    return np.where(sizes[piece] < smallest, largest[parent], piece)
+
+
+def _group(key: np.ndarray, offset: np.ndarray, gap: float, pairs: np.ndarray, smallest: int) -> np.ndarray:
+    """Cluster index of every side: sides of one key (block and side), in one plane — sorted by plane offset, a
+    new plane where it jumps by more than `gap` (a thin wall's two faces, a rug on a floor) — and connected
+    through `pairs` of neighbouring sides (two rooms' floors in one block, cut apart by the partition's voxels).
+    Pieces of fewer than `smallest` sides are no surfaces of their own (_absorb_small). Clusters are numbered by
+    (key, plane offset)."""
+    order = np.lexsort((offset, key))
+    k, d = key[order], offset[order]
+    new = np.ones(len(order), bool)
+    new[1:] = (k[1:] != k[:-1]) | (d[1:] - d[:-1] > gap)
+    plane = np.empty(len(order), np.int64)
+    plane[order] = np.cumsum(new) - 1
+    plane = _absorb_small(plane, np.unique(key, return_inverse=True)[1].reshape(-1), smallest)
+    a, b = pairs[plane[pairs[:, 0]] == plane[pairs[:, 1]]].T if len(pairs) else (np.zeros(0, int),) * 2
+    label = np.arange(len(key))
+    while True:  # connected components: each side takes the smallest label it is joined to
+        low = np.minimum(label[a], label[b])
+        previous = label.copy()
+        np.minimum.at(label, a, low)
+        np.minimum.at(label, b, low)
+        label = label[label]
+        if np.array_equal(label, previous):
+            break
+    label = _absorb_small(label, plane, smallest)
+    roots = np.unique(label)
+    rank = np.empty(len(roots), np.int64)
+    rank[np.lexsort((offset[roots], key[roots]))] = np.arange(len(roots))
+    return rank[np.searchsorted(roots, label)]
+
+
+def neighbour_pairs(cells: np.ndarray, sides: np.ndarray, size: tuple) -> np.ndarray:
+    """(P, 2) indices of entries (voxel `cells` (N, 3), `sides` (N,) 0..5) whose voxels touch (26-neighbours)
+    and whose sides match."""
+    nx, ny, nz = (int(n) for n in size)
+    lin = ((cells[:, 2] * ny + cells[:, 1]) * nx + cells[:, 0]) * 6 + sides
+    order = np.argsort(lin)
+    sorted_lin = lin[order]
+    out = []
+    for dz, dy, dx in [(dz, dy, dx) for dz in (-1, 0, 1) for dy in (-1, 0, 1) for dx in (-1, 0, 1)
+                       if (dz, dy, dx) > (0, 0, 0)]:  # half the neighbourhood: each pair once
+        moved = cells + (dx, dy, dz)
+        inside = np.all((moved >= 0) & (moved < (nx, ny, nz)), axis=1)
+        target = lin + ((dz * ny + dy) * nx + dx) * 6
+        at = np.minimum(np.searchsorted(sorted_lin, target), len(lin) - 1)
+        hit = inside & (sorted_lin[at] == target)
+        out.append(np.stack([np.nonzero(hit)[0], order[at[hit]]], axis=1))
+    return np.concatenate(out) if out else np.zeros((0, 2), np.int64)
+
+
+def make_clusters(cells: np.ndarray, normals: np.ndarray, areas: np.ndarray, fine: Grid, budget: int) -> Clusters:
+    """Cluster the surface voxels' sides (cells (R, 3) xyz, mean normals (R, 3), areas (R,)) into at most
+    `budget` clusters: the smallest block side S (from 2) whose blocks × sides × planes fit. Sides facing
+    nothing (`faces_something`) get none."""
+    lengths = np.linalg.norm(normals, axis=1)
+    valid = (areas > 0) & (lengths > 0)
+    unit = normals / np.maximum(lengths, 1e-30)[:, None]
+    centre = np.asarray(fine.origin) + (cells + 0.5) * fine.cell
+    lo, hi = (centre.min(axis=0), centre.max(axis=0)) if len(centre) else (np.zeros(3), np.zeros(3))
+    side_n = np.stack([unit, -unit], axis=1).reshape(-1, 3)  # voxel r's front at 2r, back at 2r + 1
+    pos = np.repeat(centre, 2, axis=0)
+    emits = np.repeat(valid, 2) & faces_something(pos, side_n, lo, hi, fine.cell)
+    use = np.nonzero(emits)[0]
+    offset = np.einsum("ij,ij->i", side_n[use], pos[use])
+    pairs = neighbour_pairs(cells[use // 2], side_of(side_n[use]), fine.size)
+    block = 2
+    while True:
+        key = block_keys(pos[use], side_n[use], fine, block)
+        index = _group(key, offset, 0.5 * fine.cell, pairs, max(2, block * block // 8))
+        count = int(index.max()) + 1 if len(index) else 0
+        if count <= budget or block >= max(fine.size):
+            break
+        block += 1
+    sides = np.full(2 * len(cells), -1, np.int64)
+    sides[use] = index
+    area = np.repeat(areas, 2)[use].astype(np.float64)
+    records = np.zeros(count, VPL_DTYPE)
+    total = np.bincount(index, area, count)
+    for i in range(3):
+        records["position"][:, i] = np.bincount(index, area * pos[use, i], count) / np.maximum(total, 1e-30)
+        records["normal"][:, i] = np.bincount(index, area * side_n[use, i], count)
+    n = records["normal"][:, :3]
+    records["normal"][:, :3] = n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-30)
+    records["normal"][:, 3] = total
+    records["position"][:, 3] = 1.0
+    order = np.argsort(index, kind="stable")
+    first = order[np.searchsorted(index[order], np.arange(count))]
+    offsets = np.stack([np.full(count, np.inf), np.full(count, -np.inf)], axis=1)
+    np.minimum.at(offsets[:, 0], index, offset)
+    np.maximum.at(offsets[:, 1], index, offset)
+    box = np.stack([np.full((count, 3), np.inf), np.full((count, 3), -np.inf)], axis=1)
+    np.minimum.at(box[:, 0], index, pos[use])
+    np.maximum.at(box[:, 1], index, pos[use])
+    return Clusters(block, sides.reshape(-1, 2), records, key[first], offsets, box, fine, lo, hi)
+
+
+def box_distance(points: np.ndarray, box: np.ndarray) -> np.ndarray:
+    """Distance from each point (N, 3) to each box (N, 2, 3) (0 inside)."""
+    return np.linalg.norm(np.maximum(box[:, 0] - points, 0) + np.maximum(points - box[:, 1], 0), axis=1)
+
+
+def bin_flux(clusters: Clusters, records: np.ndarray) -> tuple[np.ndarray, float]:
+    """The VPL records' flux (RGB) per cluster. A record goes to a cluster of its block and side within a voxel
+    of it, the one whose plane lies nearest; else (a texel in a voxel that the geometry around it claims for
+    another side: a floor's edge at a wall) to the nearest cluster facing its way — unless it faces nothing (a
+    sunlit roof's top: that light leaves the scene). Never to a cluster farther than the voxels around it would
+    be: two rooms' floors share a block and a plane. Returns ((C, 3), the flux that leaves)."""
+    out = np.zeros((clusters.count, 3))
+    if len(records) == 0:
+        return out, 0.0
+    pos, normal = records["position"][:, :3].astype(np.float64), records["normal"][:, :3].astype(np.float64)
+    flux = records["flux"][:, :3].astype(np.float64)
+    near = clusters.fine.cell
+    key = block_keys(pos, normal, clusters.fine, clusters.block)
+    first = np.searchsorted(clusters.key, key, "left")
+    last = np.searchsorted(clusters.key, key, "right")
+    target = np.full(len(records), -1)
+    offset = np.einsum("ij,ij->i", normal, pos)
+    best = np.full(len(records), np.inf)
+    for j in range(int((last - first).max(initial=0))):  # candidates of one key: usually one, a few planes at most
+        c = np.minimum(first + j, clusters.count - 1)
+        lo, hi = clusters.offsets[c, 0], clusters.offsets[c, 1]
+        plane = np.maximum(lo - offset, 0) + np.maximum(offset - hi, 0)
+        d = np.where((first + j < last) & (box_distance(pos, clusters.box[c]) <= near), plane, np.inf)
+        better = d < best
+        target[better], best[better] = c[better], d[better]
+    lost = np.nonzero((target < 0) & faces_something(pos, normal, clusters.lo, clusters.hi, near))[0]
+    for chunk in np.array_split(lost, max(1, len(lost) // 256)) if len(lost) and clusters.count else ():
+        facing = normal[chunk] @ clusters.records["normal"][:, :3].T > 0.5  # (n, C)
+        gap = np.maximum(clusters.box[None, :, 0] - pos[chunk, None], 0) + \
+            np.maximum(pos[chunk, None] - clusters.box[None, :, 1], 0)
+        d = np.where(facing, np.linalg.norm(gap, axis=2), np.inf)
+        target[chunk] = np.where(np.isfinite(d.min(axis=1)), np.argmin(d, axis=1), -1)
+    keep = target >= 0
+    for i in range(3):
+        out[:, i] = np.bincount(target[keep], flux[keep, i], clusters.count)
+    return out, float(flux[~keep].sum())

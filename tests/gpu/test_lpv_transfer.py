@@ -1,0 +1,101 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""The LPV's cached transport (gpu_kernels/lpv/transfer.py, the default): an edit of the lights, a material or the
+world re-runs no visibility, and what it re-runs gives exactly what a render from scratch gives.
+
+The transport's accuracy is held by the oracles of test_lpv_gather.py (parametrized over both transports) and by
+tests/accuracy/test_lpv_vs_cycles.py; here the cache's correctness: the cached result of an edit against a cold
+render of the edited scene. Both run the same float32 arithmetic on the same data, so they agree to float32
+rounding of sums of a few thousand terms: 1e-5 relative of the image's mean (measured: bitwise equal or ~1e-7).
+"""
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from bounce_gi.gpu_kernels.engine import Engine
+from bounce_gi.gpu_kernels.lpv.settings import LpvSettings
+from bounce_gi.gpu_kernels.scene import Light, Material, World
+from bounce_gi.gpu_kernels.settings import RenderSettings
+from support.synthetic import box_quads, quad_scene
+
+GEOMETRY_PASSES = ("geometry", "geometry_volume", "lpv_transfer")
+SETTINGS = RenderSettings("lpv", 48, 36, lpv=LpvSettings(resolution=16))
+
+
+def _room(light_x=-0.4, power=60.0, floor=(0.7, 0.7, 0.7), world=(0.0, 0.0, 0.0)):
+    """A 2 × 2 × 2 m room without a ceiling (a world colour lights it too), a box on the floor, a point light."""
+    quads = box_quads((-1, -1, 0), (1, 1, 2), 0, skip=((2, "hi"),)) + box_quads((0.2, -0.3, 0), (0.6, 0.1, 0.5), 1,
+                                                                         inward=False)
+    mats = [Material("floor", floor), Material("box", (0.8, 0.3, 0.2))]
+    bulb = np.eye(4)
+    bulb[:3, 3] = (light_x, 0.2, 1.4)
+    return quad_scene(quads, mats, [Light("bulb", "POINT", (1, 1, 1), power, bulb)], (0.0, -0.95, 1.0),
+                      (0.0, 0.5, 0.6), world=world, lens=12.0)
+
+
+def _indirect(result):
+    return result.passes["Diffuse Indirect"]
+
+
+def _rerun(result):
+    return [k for k, v in result.timings.items() if k != "total" and k not in result.skipped]
+
+
+def _same(a, b):
+    assert np.abs(a - b).max() <= 1e-5 * max(float(np.abs(b).mean()), 1e-12)
+
+
+@pytest.fixture(scope="module")
+def warm():
+    """An engine that rendered the room once: its cache holds the transfer."""
+    engine = Engine()
+    engine.render(_room(), SETTINGS)
+    return engine
+
+
+@pytest.mark.parametrize("edit,expected", [
+    (dict(light_x=0.3), {"shadow_maps", "rsm", "lpv_inject", "lpv_propagate"}),
+    (dict(power=120.0), {"shadow_maps", "rsm", "lpv_inject", "lpv_propagate"}),
+    (dict(floor=(0.2, 0.6, 0.9)), {"lpv_albedo", "lpv_transfer_albedo", "lpv_propagate"}),
+    (dict(world=(0.3, 0.4, 0.5)), {"lpv_world", "lpv_propagate"}),
+])
+def test_an_edit_reuses_the_transfer_and_matches_a_render_from_scratch(warm, edit, expected):
+    """Each edit re-runs what reads it (and the passes after it), never the geometry's passes; its result is a cold
+    render's to float32 rounding (see the module docstring)."""
+    scene = _room(**edit)
+    cached = warm.render(scene, SETTINGS)
+    rerun = set(_rerun(cached))
+    print(edit, "re-ran", sorted(rerun))
+    assert expected <= rerun and not rerun & set(GEOMETRY_PASSES)
+    cold = Engine().render(scene, SETTINGS)
+    assert _indirect(cold).max() > 0
+    _same(_indirect(cached), _indirect(cold))
+    warm.render(_room(), SETTINGS)  # back to the module's scene
+
+
+def test_indirect_light_is_linear_in_the_light_power(warm):
+    """The transport is linear in the light entering it: twice the power, twice the indirect light (1e-5: float32)."""
+    a = _indirect(warm.render(_room(power=60.0), SETTINGS))
+    b = _indirect(warm.render(_room(power=120.0), SETTINGS))
+    _same(b, 2.0 * a)
+
+
+def test_every_bounce_is_summed_and_the_series_stops_when_it_no_longer_adds(warm):
+    """`bounces` passes, each with less flux than the last (albedo < 1); with epsilon 0.5 the series stops after
+    the first pass that adds less than half of the largest one."""
+    info = warm.render(_room(), SETTINGS).info["cascades"][0]
+    flux = [b["flux"] for b in info["bounces"]]
+    assert info["transport"] == "transfer" and info["bounces_used"] == len(flux) == SETTINGS.lpv.bounces
+    assert all(later < earlier for earlier, later in zip(flux, flux[1:]))
+    short = warm.render(_room(), replace(SETTINGS, lpv=replace(SETTINGS.lpv, epsilon=0.5)))
+    passes = [b["flux"] for b in short.info["cascades"][0]["bounces"]]
+    assert passes[-1] <= 0.5 * passes[0] and all(p > 0.5 * passes[0] for p in passes[:-1])
+    assert len(passes) < len(flux)
+
+
+def test_a_transfer_too_large_for_its_budget_gathers_instead():
+    """transfer_mb too small for a cascade's surface voxels × MIN_CLUSTERS: the per-bounce gather runs, and says so
+    by its own statistics (VPL counts per bounce)."""
+    r = Engine().render(_room(), replace(SETTINGS, lpv=replace(SETTINGS.lpv, transfer_mb=1)))
+    assert "lpv_transfer" not in r.timings
+    assert "vpls" in r.info["cascades"][0]["bounces"][0]

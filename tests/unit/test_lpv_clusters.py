@@ -1,0 +1,108 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""The cached LPV transport's bookkeeping (gpu_kernels/lpv/clusters.py, transfer.py), without a GPU: clusters, the binning of
+VPL flux into them, and the factored bounce series against the series computed bounce by bounce."""
+import numpy as np
+import pytest
+
+from bounce_gi.gpu_kernels.common.grid import Grid
+from bounce_gi.gpu_kernels.lpv import clusters as cl
+from bounce_gi.gpu_kernels.lpv import transfer as tr
+from bounce_gi.gpu_kernels.lpv.gather import VPL_DTYPE
+
+FINE = Grid((0.0, 0.0, 0.0), 0.1, (40, 40, 40))
+
+
+def _plane(axis, index, lo, hi, sign=1.0):
+    """Voxels of an axis plane at fine index `index` spanning [lo, hi) on the other two axes; normals ±axis."""
+    u, w = (axis + 1) % 3, (axis + 2) % 3
+    a, b = np.meshgrid(np.arange(lo[0], hi[0]), np.arange(lo[1], hi[1]), indexing="ij")
+    cells = np.zeros((a.size, 3), np.int64)
+    cells[:, axis], cells[:, u], cells[:, w] = index, a.ravel(), b.ravel()
+    normals = np.zeros((a.size, 3))
+    normals[:, axis] = sign
+    return cells, normals
+
+
+def _scene(*planes):
+    cells = np.concatenate([p[0] for p in planes])
+    normals = np.concatenate([p[1] for p in planes])
+    return cells, normals, np.full(len(cells), 0.01)
+
+
+def _records(points, normals, flux):
+    rec = np.zeros(len(points), VPL_DTYPE)
+    rec["position"][:, :3], rec["position"][:, 3] = points, 1.0
+    rec["normal"][:, :3] = normals
+    rec["flux"][:, :3] = flux
+    return rec
+
+
+def test_clusters_fit_the_budget_keep_floor_and_wall_apart_and_skip_sides_facing_nothing():
+    """A floor (z index 0) and a wall (x index 0) of a room, 4 × 4 m: every inward side belongs to a cluster of
+    its own orientation, areas add up, at most `budget` clusters; the outward sides have the whole scene behind
+    them (faces_something) and get none."""
+    cells, normals, areas = _scene(_plane(2, 0, (0, 0), (40, 40)), _plane(0, 0, (0, 1), (40, 40)))
+    c = cl.make_clusters(cells, normals, areas, FINE, budget=64)
+    assert c.count <= 64
+    inward = c.side_cluster[:, 0]  # the front side: +z for the floor, +x for the wall
+    assert (inward >= 0).all() and (c.side_cluster[:, 1] < 0).all()
+    cluster_normal = c.records["normal"][inward, :3]
+    assert np.allclose(cluster_normal, normals)  # no cluster mixes the floor with the wall
+    assert c.records["normal"][:, 3].sum() == pytest.approx(areas.sum(), rel=1e-6)
+
+
+def test_two_rooms_floors_in_one_block_stay_apart_and_keep_their_flux():
+    """Two floors in one plane, separated by a partition (two wall-voxel columns that belong to no floor): no
+    cluster spans both, so flux binned from the left floor stays on the left (two rooms lit independently)."""
+    left = _plane(2, 5, (0, 0), (13, 40))
+    right = _plane(2, 5, (15, 0), (40, 40))
+    wall = _plane(0, 13, (5, 0), (40, 40)), _plane(0, 14, (5, 0), (40, 40))
+    cells, normals, areas = _scene(left, right, *wall)
+    c = cl.make_clusters(cells, normals, areas, FINE, budget=40)
+    assert 12 // c.block == 15 // c.block  # a block holds both floors: only the connectivity keeps them apart
+    floor = c.records["normal"][:, 2] > 0.99
+    lo, hi = c.box[floor, 0, 0], c.box[floor, 1, 0]  # x extent of each floor cluster's voxels
+    assert ((hi < 1.3) | (lo > 1.5)).all()
+    rng = np.random.default_rng(3)
+    points = np.c_[rng.uniform(0.0, 1.25, 500), rng.uniform(0.0, 4.0, 500), np.full(500, 0.55)]
+    flux, escaped = cl.bin_flux(c, _records(points, np.tile((0, 0, 1.0), (500, 1)), rng.uniform(0, 1, (500, 3))))
+    assert escaped == 0 and flux[:, 0].sum() > 0
+    lit = flux[:, 0] > 0
+    assert (c.box[lit, 1, 0] < 1.3).all()
+
+
+def test_flux_on_a_side_facing_nothing_leaves_the_scene():
+    """A sunlit roof's top (the scene's highest surface, facing up): its light reaches no receiver — it is
+    counted as escaped, not moved onto another surface."""
+    cells, normals, areas = _scene(_plane(2, 0, (0, 0), (40, 40)), _plane(2, 30, (0, 0), (40, 40)))
+    c = cl.make_clusters(cells, normals, areas, FINE, budget=64)
+    top = np.c_[np.full(10, 2.0), np.full(10, 2.0), np.full(10, 3.05)]
+    flux, escaped = cl.bin_flux(c, _records(top, np.tile((0, 0, 1.0), (10, 1)), np.ones((10, 3))))
+    assert flux.sum() == 0 and escaped == pytest.approx(30.0)
+
+
+def test_the_factored_series_equals_the_bounce_by_bounce_series():
+    """solve() sums Φ_1 … Φ_N through M_ρ (cluster to cluster) and applies T once; the definition applies T every
+    bounce and reflects per receiver side: E_k = T·Φ_k, Φ_(k+1) = reflect(E_k). Random T, albedo and sources;
+    equal to float32 rounding (1e-5)."""
+    rng = np.random.default_rng(7)
+    cells, normals, areas = _scene(_plane(2, 0, (0, 0), (40, 40)), _plane(0, 0, (0, 1), (40, 40)),
+                                   _plane(1, 39, (0, 1), (40, 40), sign=-1.0))
+    c = cl.make_clusters(cells, normals, areas, FINE, budget=48)
+    r = len(cells)
+    matrix = rng.uniform(0, 2e-3, (2, c.count, r)).astype(np.float32)
+    t = tr.sort_by_cluster(c, matrix)
+    weight = rng.uniform(0.2, 0.9, (r, 3)) * areas[:, None]
+    first = rng.uniform(0, 5, (c.count, 3))
+    world = rng.uniform(0, 0.1, (2, r, 3))
+    m = tr.albedo_transfer(t, weight)
+    total, passes = tr.solve(t, m, weight, first, world, bounces=5, epsilon=0.0)
+
+    expected = world.copy()
+    phi = first
+    for k in range(5):
+        e = np.stack([(matrix[s].T @ phi) for s in range(2)])
+        expected += e
+        phi = tr.reflect(c, weight, e + (world if k == 0 else 0))
+    assert len(passes) == 5
+    assert np.abs(total - expected).max() <= 1e-5 * np.abs(expected).max()
