@@ -64,6 +64,7 @@ class LiveStats:
     warnings: list = field(default_factory=list)
     lights: dict = field(default_factory=dict)  # light type → count
     grid: str = ""  # the method's grid, e.g. "64 x 64 x 32"
+    skipped_work: list = field(default_factory=list)  # what the scene let the method leave out, in words
     error: str = ""
     changed: str = ""  # what the last edit changed (changes.ChangeSet.describe)
 
@@ -155,6 +156,7 @@ class LiveSession:
             list(light.warnings), ""
         s.texels, s.texel_size, s.triangles = light.atlas.texel_count, light.atlas.texel, drawing.triangles
         s.lights = {k: v for k, v in light.statistics.get("lights", {}).items() if v}
+        s.skipped_work = list(light.info.get("skipped_work", []))
         grid = light.info.get("grid") or light.info.get("grids")
         s.grid = " x ".join(str(n) for n in grid) if isinstance(grid, (list, tuple)) and grid and \
             all(isinstance(n, int) for n in grid) else (str(grid) if grid else "")

@@ -97,6 +97,8 @@ class VIEW3D_PT_bounce_gi_viewport(Panel):
             layout.label(text=f"Lights: {lights}")
         if s.grid:
             layout.label(text=f"Grid: {s.grid}")
+        for text in s.skipped_work:
+            layout.label(text=f"Skipped {text}", icon="FORWARD")
         for text in s.warnings:
             layout.label(text=text, icon="ERROR")
 

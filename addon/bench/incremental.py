@@ -4,17 +4,25 @@
 An update is what the add-on does after an edit: extract the evaluated scene, then `Engine.render`, whose pass cache
 re-runs only the passes whose inputs changed (gpu_kernels/gl/pass_cache.py). Each kind of edit is applied to the open
 .blend with bpy (alternately +d and −d, so the scene stays put), and the median of `repeats` updates is reported.
-The file is never saved.
+Beside them: Cycles re-rendering the same scene at 1 sample + OpenImageDenoise (the peer an edit must beat), and
+what the LPV's cached transport holds in memory at a few grid resolutions. The file is never saved.
 """
 from __future__ import annotations
 
+import os
 import statistics
 import time
 
 from ..scene_io import load_scene
 
-KINDS = ("full", "unchanged", "camera_only", "light_move", "material_change", "object_move")
+KINDS = ("full", "unchanged", "camera_only", "light_move", "light_power", "material_change", "world_change",
+         "object_move")
 STEP = 0.05  # metres (or colour units) per edit: small enough to stay a "typical" interactive nudge
+# The targets (fractions of `full`) an edit is held to, and the speed-up over Cycles 1 spp + OIDN of a light move.
+TARGETS = {"unchanged": 0.01, "camera_only": 0.25, "light_move": 0.10, "light_power": 0.10, "material_change": 0.10,
+           "world_change": 0.10, "object_move": 0.40}
+PEER_SPEEDUP = 3.0
+MEMORY_RESOLUTIONS = (32, 64, 128)
 
 
 def _update(engine, settings, resolution):
@@ -41,6 +49,29 @@ def _base_color_socket(material):
     return None
 
 
+def _world_edit(scene):
+    """An edit of the world: its Background node's colour (or the world's viewport colour) nudged; a world of
+    strength 0 is switched on (strength 1) by the first edit."""
+    world = scene.world
+    if world is None:
+        return "the scene has no world"
+    node = next((n for n in world.node_tree.nodes if n.type == "BACKGROUND"), None) if world.node_tree else None
+    sock = node.inputs.get("Color") if node is not None else None
+    if sock is not None and sock.is_linked:
+        return "the world's colour is driven by a node tree (a sky texture), not a value to nudge"
+
+    strength = node.inputs.get("Strength") if node is not None else None
+
+    def recolour(sign):
+        if strength is not None and strength.default_value == 0:
+            strength.default_value = 1.0  # a world switched off: it stays on (once), its colour is the edit
+        if sock is not None:
+            sock.default_value[2] = max(0.0, sock.default_value[2] + sign * STEP)
+        else:
+            world.color[2] = max(0.0, world.color[2] + sign * STEP)
+    return recolour
+
+
 def _edits(bpy):
     """kind → a function edit(sign) applying a small change, or a reason the scene has nothing to edit."""
     scene = bpy.context.scene
@@ -55,6 +86,13 @@ def _edits(bpy):
 
     edits["camera_only"] = mover(scene.camera, 0) if scene.camera else "the scene has no camera"
     edits["light_move"] = mover(lights[0], 0) if lights else "the scene has no light object (emission only)"
+    if lights:
+        def brighten(sign):
+            lights[0].data.energy *= 1.25 if sign > 0 else 0.8
+        edits["light_power"] = brighten
+    else:
+        edits["light_power"] = "the scene has no light object (emission only)"
+    edits["world_change"] = _world_edit(scene)
     if meshes:
         # the smallest object: moving a wall of a room would be an unusual edit
         smallest = min(meshes, key=lambda o: max(o.dimensions))
@@ -92,7 +130,7 @@ def measure_incremental(scene_resolution, method: str, repeats: int = 3) -> dict
     def record(kind, runs):
         out[kind] = statistics.median(r[0] for r in runs)
         last = runs[-1][2]
-        detail[kind] = {"extract": statistics.median(r[1] for r in runs),
+        detail[kind] = {"extract": statistics.median(r[1] for r in runs), "runs": [r[0] for r in runs],
                         "rerun": [k for k, v in last.timings.items() if k != "total" and k not in last.skipped]}
 
     runs = []
@@ -118,13 +156,66 @@ def measure_incremental(scene_resolution, method: str, repeats: int = 3) -> dict
     return {**{k: out.get(k) for k in KINDS}, "detail": detail}
 
 
+def time_cycles_1spp_oidn(resolution, tmp: str, repeats: int = 3) -> float | None:
+    """Median seconds of Cycles re-rendering the open scene at 1 sample + OpenImageDenoise (after a warm-up), as
+    bench's peers are timed (peers.render_exr); None if Cycles fails here."""
+    import bpy
+
+    from ..reference.cycles import ReferenceSettings, configure_cycles, saved_attributes, settings_to_save
+    from .peers import render_exr
+
+    scene, view_layer = bpy.context.scene, bpy.context.view_layer
+    path = os.path.join(tmp, "cycles_1spp_oidn.exr")
+    with saved_attributes(settings_to_save(scene, view_layer) + [(scene.cycles, "denoiser")]):
+        configure_cycles(scene, view_layer, ReferenceSettings(*resolution, samples=1), 3, path)
+        scene.cycles.use_denoising = True
+        scene.cycles.denoiser = "OPENIMAGEDENOISE"
+        try:
+            runs = [render_exr(bpy, path)[0] for _ in range(repeats + 1)][1:]
+        except Exception:  # noqa: BLE001 — a peer failing must not end the benchmark
+            return None
+    return statistics.median(runs)
+
+
+def transfer_memory(scene) -> list:
+    """The LPV cached transport's size at MEMORY_RESOLUTIONS (estimated from the surface area)."""
+    from ...gpu_kernels.lpv.passes import transfer_estimate
+    from ...gpu_kernels.lpv.settings import LpvSettings
+
+    return [transfer_estimate(scene, LpvSettings(resolution=n)) for n in MEMORY_RESOLUTIONS]
+
+
 def run_incremental(path: str, res, methods, progress, repeats: int = 3) -> dict:
+    import tempfile
+
     scene = load_scene(path, tuple(res) if res else None)
     result = {"scene": path, "resolution": list(scene.resolution), "methods": {}}
     for method in methods:
         progress(f"bench --incremental: {method}")
         result["methods"][method] = measure_incremental(tuple(scene.resolution), method, repeats)
+    progress("bench --incremental: Cycles 1 spp + OIDN")
+    with tempfile.TemporaryDirectory() as tmp:
+        result["peers"] = {"cycles_1spp_oidn": time_cycles_1spp_oidn(tuple(scene.resolution), tmp, repeats)}
+    result["lpv_transfer_memory"] = transfer_memory(scene)
     return result
+
+
+def verdicts(entry: dict) -> list:
+    """One line per method and kind: its fraction of `full` against TARGETS, and a light move against the peer."""
+    lines, peer = [], entry.get("peers", {}).get("cycles_1spp_oidn")
+    for method, m in entry["methods"].items():
+        if method == "none" or not m.get("full"):
+            continue
+        for kind, target in TARGETS.items():
+            if m.get(kind) is not None:
+                share = m[kind] / m["full"]
+                lines.append(f"- {method} {kind}: {share:.1%} of full (target ≤ {target:.0%}): "
+                             f"{'met' if share <= target else 'NOT met'}")
+        if peer and m.get("light_move"):
+            speedup = peer / m["light_move"]
+            lines.append(f"- {method} light_move vs Cycles 1 spp + OIDN ({peer * 1000:.0f} ms): {speedup:.2f}× "
+                         f"(target ≥ {PEER_SPEEDUP:.0f}×): {'met' if speedup >= PEER_SPEEDUP else 'NOT met'}")
+    return lines
 
 
 def format_incremental(entry: dict) -> str:
@@ -134,12 +225,21 @@ def format_incremental(entry: dict) -> str:
     for method, m in entry["methods"].items():
         cells = ["—" if m[k] is None else f"{m[k] * 1000:.1f}" for k in KINDS]
         lines.append(f"| {method} | " + " | ".join(cells) + " |")
-    lines.append("")
+    peer = entry.get("peers", {}).get("cycles_1spp_oidn")
+    lines += ["", f"Cycles 1 spp + OIDN, same scene and resolution: "
+                  f"{'failed' if peer is None else f'{peer * 1000:.1f} ms'} (median of 3 after a warm-up).", ""]
+    lines += verdicts(entry) + [""]
     for method, m in entry["methods"].items():
         for k in KINDS:
             d = m["detail"].get(k, {})
             if "note" in d:
                 lines.append(f"- {method} {k}: {d['note']}")
-            else:
+            elif d:
                 lines.append(f"- {method} {k}: extract {d['extract'] * 1000:.1f} ms; re-ran {', '.join(d['rerun'])}")
+    memory = entry.get("lpv_transfer_memory")
+    if memory:
+        lines += ["", "LPV cached transport (host memory, float32; estimated from the surface area):", "",
+                  "| grid | surface voxels | clusters | T (MiB) | transport |", "|---:|---:|---:|---:|---|"]
+        lines += [f"| {m['resolution']}³ | {m['surface_voxels']} | {m['clusters']} | {m['mb']:.0f} | {m['transport']} |"
+                  for m in memory]
     return "\n".join(lines) + "\n"

@@ -25,7 +25,7 @@ def cmd_render(args) -> dict:
     write_output(exr_io.write_passes, out, result.passes)
     report = {"method": result.method, "resolution": list(result.resolution),
               "seconds": {k: round(v, 6) for k, v in result.timings.items()}, "skipped": result.skipped,
-              "info": result.info,
+              "info": result.info, "skipped_work": result.info.get("skipped_work", []),
               "scene": result.statistics, "warnings": result.warnings, "output": out}
     if quality:
         report["quality"] = quality
@@ -33,6 +33,8 @@ def cmd_render(args) -> dict:
         print(format_timings(result.timings))
         for w in result.warnings:
             print(f"warning: {w}")
+        for text in report["skipped_work"]:
+            print(f"skipped {text}")
         print(f"wrote {out}")
     return report
 

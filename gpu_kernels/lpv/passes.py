@@ -15,7 +15,7 @@ alone and the passes are instead:
     lpv_albedo           ← geometry volume, materials          (the surface voxels' albedo)
     lpv_transfer         ← geometry volume, budget             (clusters and the kernel T: the expensive part)
     lpv_transfer_albedo  ← transfer, albedo                    (M_ρ: cluster-to-cluster reflection)
-    lpv_world            ← geometry volume, world, settings    (the world light, propagated and absorbed)
+    lpv_world            ← geometry volume, settings           (a unit world, propagated and absorbed: × colour)
     lpv_inject           ← rsm, transfer                       (the RSM's flux per cluster)
     lpv_propagate        ← all of the above, bounces           (the bounce series and one product with T)
     lpv_lighting         ← gbuffer, transport
@@ -123,9 +123,13 @@ def _transfer(frame, grids, k_grids, maps, k_rsm, budget) -> MethodOutput:
     m_rho = cache.run("lpv_transfer_albedo", k_m, lambda: [
         transfer.albedo_transfer(t, w) for t, w in zip(transfers, weights)])
     world = tuple(float(c) for c in scene.world.color[:3])
+    worlds = [None] * len(gvs)  # a black world: nothing to propagate (a sky it lit before stays cached)
+    if max(world) > 0:
+        k_sky = (k_gv, s.max_iterations, s.epsilon, s.clamp_negative)
+        skies = cache.run("lpv_world", k_sky, lambda: [_sky(ctx, programs, gv, grid, s)
+                                                       for gv, grid in zip(gvs, grids)])
+        worlds = [sky[..., None] * np.asarray(world) for sky in skies]
     k_world = (k_gv, world, s.max_iterations, s.epsilon, s.clamp_negative)
-    worlds = cache.run("lpv_world", k_world, lambda: [_world(ctx, programs, gv, grid, world, s)
-                                                      for gv, grid in zip(gvs, grids)])
     k_src = (k_rsm, k_tr)
     sources = cache.run("lpv_inject", k_src, lambda: [clusters.bin_flux(t.clusters, gather.rsm_records(
         ctx, programs, maps, frame.shadows, grid, budget)[0]) for t, grid in zip(transfers, grids)])
@@ -135,7 +139,22 @@ def _transfer(frame, grids, k_grids, maps, k_rsm, budget) -> MethodOutput:
     k_light = (frame.keys["gbuffer"], k_prop)
     indirect = cache.run("lpv_lighting", k_light,
                          lambda: lighting.lighting(ctx, programs, frame.gbuffer, solved["surfaces"], gvs, s))
-    return MethodOutput(indirect, None, k_light, {"cascades": solved["stats"]})
+    return MethodOutput(indirect, None, k_light, {"cascades": solved["stats"],
+                                                  "skipped_work": skipped_work(solved["stats"], s)})
+
+
+def skipped_work(stats: list, s) -> list:
+    """What the scene let the cached transport leave out, in words (render --json "skipped_work", the panel)."""
+    out = []
+    for c in stats[:1]:  # the cascades skip alike
+        if not c["world"]:
+            out.append("world light: the world is black, nothing propagates")
+        if c["injected_flux"] == 0:
+            out.append("first bounce: no light reaches a surface the transport sees (no lights, or all off)")
+        if c["bounces_used"] < s.bounces:
+            out.append(f"bounces {c['bounces_used'] + 1}-{s.bounces}: the series stopped after {c['bounces_used']} "
+                       f"(a bounce added less than epsilon = {s.epsilon:g} of the largest)")
+    return out
 
 
 def _build(ctx, programs, gv, grid, budget, s) -> transfer.Transfer:
@@ -147,19 +166,18 @@ def _build(ctx, programs, gv, grid, budget, s) -> transfer.Transfer:
     return transfer.sort_by_cluster(sources, matrix)
 
 
-def _world(ctx, programs, gv, grid, world, s):
-    """The world light's irradiance on the surface voxels, (2, R, 3), propagated in from the open border and
-    absorbed as in gather.gather_all; None under a black world (nothing runs)."""
-    if max(world) <= 0:
-        return None
+def _sky(ctx, programs, gv, grid, s) -> np.ndarray:
+    """The irradiance a world of unit radiance gives each surface voxel, (2, R) per side: propagated in from the
+    open border and absorbed as in gather.gather_all. Linear in the world's radiance (the propagation is, and its
+    stopping test is relative), so a world edit multiplies this by the new colour and propagates nothing."""
     state = LpvGridState(ctx, grid)
     try:
-        state.injected_flux = inject.inject(ctx, programs, None, None, state, world, gv, vpls=False)
+        state.injected_flux = inject.inject(ctx, programs, None, None, state, (1.0, 1.0, 1.0), gv, vpls=False)
         state.face_flux.clear()
         propagate.propagate(ctx, programs, state, state.injected, state.injected_flux, gv.blocking, s,
                             accumulate=False)
         occlusion.absorb(ctx, programs, state, gv, add=False)
-        return transfer.read_sides(state, gv.cells)
+        return transfer.read_sides(state, gv.cells)[..., 0]
     finally:
         state.release()
 

@@ -126,8 +126,11 @@ def test_incremental_reruns_only_what_changed(env, cornell):
     proc = run(env, "bench", cornell, "--incremental", "--quick", "--res", 40, 30, "--json")
     assert proc.returncode == 0, describe(proc)
     (entry,) = json.loads(proc.stdout.strip().splitlines()[-1])["incremental"]
+    assert entry["peers"]["cycles_1spp_oidn"] > 0  # timed in the same run
+    assert [m["resolution"] for m in entry["lpv_transfer_memory"]] == [32, 64, 128]
     for method, m in entry["methods"].items():
-        for kind in ("full", "unchanged", "camera_only", "light_move", "material_change", "object_move"):
+        for kind in ("full", "unchanged", "camera_only", "light_move", "light_power", "material_change",
+                     "world_change", "object_move"):
             assert m[kind] is not None and m[kind] > 0, (method, kind)
         rerun = {k: set(d["rerun"]) for k, d in m["detail"].items()}
         assert rerun["unchanged"] == set(), method
@@ -137,6 +140,12 @@ def test_incremental_reruns_only_what_changed(env, cornell):
                                            "vct_inject"}, method
         assert "geometry" not in rerun["light_move"] and "shadow_maps" in rerun["light_move"], method
         assert "geometry" in rerun["object_move"], method
+    # the LPV's cached transport: no edit of lights, materials or world rebuilds it
+    lpv = {k: set(d["rerun"]) for k, d in entry["methods"]["lpv"]["detail"].items()}
+    for kind in ("light_move", "light_power", "material_change", "world_change"):
+        assert not lpv[kind] & {"geometry_volume", "lpv_transfer"}, kind
+    assert "lpv_transfer" in lpv["object_move"] and "lpv_albedo" in lpv["material_change"]
+    assert lpv["world_change"] >= {"lpv_world"} and "rsm" not in lpv["world_change"]
 
 
 def test_bad_input(env, cornell, tmp_path):

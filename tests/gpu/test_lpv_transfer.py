@@ -99,3 +99,14 @@ def test_a_transfer_too_large_for_its_budget_gathers_instead():
     r = Engine().render(_room(), replace(SETTINGS, lpv=replace(SETTINGS.lpv, transfer_mb=1)))
     assert "lpv_transfer" not in r.timings
     assert "vpls" in r.info["cascades"][0]["bounces"][0]
+
+
+def test_a_world_colour_edit_propagates_nothing(warm):
+    """The world's light is linear in its radiance: a unit world is propagated once per geometry (lpv_world), and
+    a colour edit only scales it — no propagation re-runs, and the result is a cold render's."""
+    warm.render(_room(world=(0.3, 0.4, 0.5)), SETTINGS)
+    scene = _room(world=(0.9, 0.2, 0.1))
+    cached = warm.render(scene, SETTINGS)
+    assert "lpv_world" in cached.skipped and "lpv_propagate" in _rerun(cached)
+    _same(_indirect(cached), _indirect(Engine().render(scene, SETTINGS)))
+    warm.render(_room(), SETTINGS)
