@@ -62,6 +62,7 @@ class VIEW3D_PT_bounce_gi(Panel):
         row = layout.row(align=True)
         row.operator("bounce_gi.toggle_overlay", text="GI Overlay", icon="OVERLAY", depress=overlay.is_on())
         row.prop(settings, "display_mode", text="")
+        layout.operator("bounce_gi.bake_color_attribute", icon="GROUP_VCOL")
 
 
 class VIEW3D_PT_bounce_gi_viewport(Panel):
