@@ -93,15 +93,29 @@ def write_text_atomic(path: str, text: str) -> None:
 
 def load_scene(path: str, resolution=None):
     """Open a .blend with bpy and extract its Scene; raise CliError for scenes that cannot be rendered."""
-    import bpy
+    path = open_blend(path)
+    return extract_open_scene(path, resolution)
 
-    from .extract import ExtractError, extract_scene
+
+def open_blend(path: str) -> str:
+    """Open a .blend with bpy (its absolute path back); CliError when it is not one or Blender cannot read it."""
+    import bpy
 
     path = check_blend_path(path)
     try:
         bpy.ops.wm.open_mainfile(filepath=path, load_ui=False)
     except RuntimeError as exc:
         raise CliError(f"{path}: Blender could not open it ({str(exc).strip().splitlines()[-1]})") from None
+    return path
+
+
+def extract_open_scene(path: str, resolution=None):
+    """Extract the Scene of the open .blend at its current frame; CliError (naming `path`) for scenes that cannot
+    be rendered."""
+    import bpy
+
+    from .extract import ExtractError, extract_scene
+
     try:
         scene = extract_scene(bpy.context.evaluated_depsgraph_get(), resolution)
     except ExtractError as exc:

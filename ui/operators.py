@@ -17,7 +17,7 @@ from .preview import PreviewError
 POLL_INTERVAL = 0.1
 
 
-def _set_status(context, text):
+def set_status(context, text):
     """Show progress in the status bar (None clears it). The workspace may be gone in odd states."""
     workspace = getattr(context, "workspace", None)
     if workspace is not None:
@@ -118,7 +118,7 @@ class BOUNCE_GI_OT_render_preview(Operator):
 
     def _progress(self, context):
         p = self._pending
-        _set_status(context, f"Bounce GI: rendering {p.width}x{p.height} ({p.method}) "
+        set_status(context, f"Bounce GI: rendering {p.width}x{p.height} ({p.method}) "
                              f"{p.elapsed():.1f} s   Esc: stop waiting")
         preview.tag_redraw_all(("VIEW_3D",))
 
@@ -127,7 +127,7 @@ class BOUNCE_GI_OT_render_preview(Operator):
             context.window_manager.event_timer_remove(preview.state.timer)
             preview.state.timer = None
         preview.state.busy = False
-        _set_status(context, None)
+        set_status(context, None)
         preview.tag_redraw_all()
 
 

@@ -3,12 +3,13 @@
 Render Properties panel shown while Bounce GI is the render engine (same settings, same draw function).
 
 Panels only read state; everything they show about the last render comes from
-`preview.state`, which lives in memory and is never written into the .blend.
+`preview.state` (the last comparison with Cycles: `compare.state`), which lives in memory and is never
+written into the .blend.
 """
 import bpy
 from bpy.types import Panel
 
-from . import overlay, preview, viewport
+from . import compare, overlay, preview, viewport
 
 
 def _format_seconds(seconds: float) -> str:
@@ -61,6 +62,7 @@ class VIEW3D_PT_bounce_gi(Panel):
         row = layout.row(align=True)
         row.operator("bounce_gi.toggle_overlay", text="GI Overlay", icon="OVERLAY", depress=overlay.is_on())
         row.prop(settings, "display_mode", text="")
+        layout.operator("bounce_gi.bake_color_attribute", icon="GROUP_VCOL")
 
 
 class VIEW3D_PT_bounce_gi_viewport(Panel):
@@ -148,6 +150,60 @@ class VIEW3D_PT_bounce_gi_last_render(Panel):
                 box_col.label(text=text, icon="ERROR")
 
 
+class VIEW3D_PT_bounce_gi_compare(Panel):
+    """Compare with Cycles: samples, the button, and rel-L1 per pass of the last comparison."""
+
+    bl_space_type = "VIEW_3D"
+    bl_region_type = "UI"
+    bl_category = "Bounce GI"
+    bl_label = "Compare with Cycles"
+    bl_parent_id = "VIEW3D_PT_bounce_gi"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.prop(context.scene.bounce_gi, "compare_samples")
+        state = compare.state
+        row = layout.row()
+        if state.busy:
+            row.enabled = False
+            row.operator("bounce_gi.compare_cycles", text="Comparing...", icon="TIME")
+            if state.status:
+                layout.label(text=state.status)
+        else:
+            row.operator("bounce_gi.compare_cycles", icon="IMAGE_REFERENCE")
+        if state.last_error:
+            layout.label(text=state.last_error, icon="ERROR")
+        if state.last is not None:
+            draw_compare_report(layout, state.last)
+
+
+def draw_compare_report(layout, report: dict) -> None:
+    """rel-L1 per pass beside Cycles' own noise, relMSE, times and the images to look at."""
+    ref = report["reference"]
+    layout.label(text=f"{report['method'].upper()} {report['resolution'][0]} x {report['resolution'][1]} vs "
+                      f"Cycles {ref['samples']} spp x 2", icon="IMAGE_DATA")
+    col = layout.column(align=True)
+    split = col.split(factor=0.5)
+    split.label(text="Pass")
+    split.split(factor=0.5).label(text="rel-L1")
+    split.label(text="noise")
+    for key, label in compare.PASS_LABELS.items():
+        split = col.split(factor=0.5)
+        split.label(text=label)
+        row = split.split(factor=0.5)
+        row.label(text=f"{report['rel_l1'][key]:.3f}")
+        row.label(text=f"{report['noise_floor'][key]:.3f}")
+    col.label(text=f"relMSE {report['rel_mse']:.4f}; Diffuse Color match {report['diffuse_color_match']:.1%}")
+    s = report["seconds"]
+    col.label(text=f"Ours {_format_seconds(s['ours'])}; Cycles {_format_seconds(s['cycles'])}"
+                   + (" (cached)" if s["cycles_cached"] else ""))
+    col.label(text="Images: " + ", ".join(name.removeprefix("Bounce GI Compare: ") for name in compare.IMAGES.values()))
+    for text in report["warnings"]:
+        layout.label(text=text, icon="ERROR")
+
+
 class RENDER_PT_bounce_gi(Panel):
     """Render Properties with the Bounce GI engine: what F12 and `blender -b -E BOUNCE_GI` render with. The render
     size is the scene's (Format panel), so the preview's resolution and Output settings are not shown here."""
@@ -167,7 +223,8 @@ class RENDER_PT_bounce_gi(Panel):
         self.layout.prop(context.scene.bounce_gi, "display_mode")
 
 
-classes = (VIEW3D_PT_bounce_gi, VIEW3D_PT_bounce_gi_viewport, VIEW3D_PT_bounce_gi_last_render, RENDER_PT_bounce_gi)
+classes = (VIEW3D_PT_bounce_gi, VIEW3D_PT_bounce_gi_viewport, VIEW3D_PT_bounce_gi_last_render,
+           VIEW3D_PT_bounce_gi_compare, RENDER_PT_bounce_gi)
 
 
 def register():

@@ -73,6 +73,7 @@ class PendingRender:
     started: float = field(default_factory=time.perf_counter)
     quality: str = ""
     output: str = ""  # absolute path of the EXR to write the passes to, "" for none
+    scene_data: object = None  # the extracted gpu_kernels.scene.Scene that was submitted
 
     def elapsed(self) -> float:
         return time.perf_counter() - self.started
@@ -147,7 +148,8 @@ def submit_scene(depsgraph, resolution: tuple[int, int]) -> PendingRender:
         raise PreviewError(one_line(ex)) from None
     except Exception as ex:
         raise _unexpected(ex, "render submission") from None
-    return PendingRender(future, render_settings.method, width, height, list(scene_data.warnings), quality=quality)
+    return PendingRender(future, render_settings.method, width, height, list(scene_data.warnings), quality=quality,
+                         scene_data=scene_data)
 
 
 def render_settings_of(settings, width: int, height: int):

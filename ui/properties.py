@@ -88,6 +88,16 @@ class BounceGISettings(PropertyGroup):
         default="",
     )
 
+    compare_samples: IntProperty(
+        name="Cycles Samples",
+        description="Samples per pixel of each of the two seeds of the Cycles reference that Compare with Cycles "
+                    "renders (at the preview resolution; cached, so a second comparison of the same scene is "
+                    "instant)",
+        min=1,
+        soft_max=4096,
+        default=64,
+    )
+
     display_mode: EnumProperty(
         name="Display",
         description="What Rendered shading and the overlay draw",

@@ -5,9 +5,12 @@ farm manager that runs exactly that.
 `render(depsgraph)` extracts the frame's scene at Blender's render size (resolution × percentage), submits it with
 the scene's Bounce GI settings (the same steps as the preview: preview.submit_scene), waits for the engine in short
 polls that honour Esc (`test_break`), then writes every pass of gpu_kernels.compose into the render result under its
-Cycles name. The result is begun only once every pass is in hand, so a failure never leaves a half-written one: it
-is one ERROR report and an empty result. With Render Region (`use_border`) the full frame is rendered and the
-region copied out (Blender then crops or places it, as for any engine). One render per view layer, mono only.
+Cycles name, and prints one log line a frame: its time and the passes the engine's cache reused (an animation,
+`-a`, renders every frame through the one process-wide engine, so a frame where only a light moved reuses the
+geometry and G-buffer of the frame before). The result is begun only once every pass is in hand, so a failure
+never leaves a half-written one: it is one ERROR report and an empty result. With Render Region (`use_border`) the
+full frame is rendered and the region copied out (Blender then crops or places it, as for any engine). One render
+per view layer, mono only.
 
 Rendered shading: `view_update` hands the depsgraph's updates to a viewport.ViewportFeed (extract what the GI
 depends on, queue one job on the GPU thread, never wait); `view_draw` draws the newest finished result from the
@@ -65,6 +68,14 @@ def result_pixels(image: np.ndarray, rect: tuple[int, int, int, int]) -> np.ndar
         a = a[..., None]
     bottom_up = a[::-1]
     return np.ascontiguousarray(bottom_up[y:y + h, x:x + w]).reshape(w * h, a.shape[2])
+
+
+def frame_log_line(frame: int, pending, result) -> str:
+    """`Bounce GI: frame 2: LPV 64 x 48 in 812 ms (wall 0.85 s); reused geometry, textures, gbuffer`."""
+    total = result.timings.get("total", pending.elapsed())
+    reused = ", ".join(result.skipped) or "nothing"
+    return (f"Bounce GI: frame {frame}: {pending.method.upper()} {pending.width} x {pending.height} in "
+            f"{total * 1000:.0f} ms (wall {pending.elapsed():.2f} s); reused {reused}")
 
 
 class BounceGIRenderEngine(bpy.types.RenderEngine):
@@ -151,7 +162,7 @@ class BounceGIRenderEngine(bpy.types.RenderEngine):
             traceback.print_exc()
             self.report({"ERROR"}, f"Bounce GI render failed: {type(ex).__name__}: {preview.one_line(ex)}")
             return
-        self._report_done(pending, result)
+        self._report_done(pending, result, depsgraph.scene.frame_current)
 
     def _wait(self, pending) -> bool:
         """Wait for the engine, polling so Esc works; False when the user cancelled. A render already running on
@@ -186,11 +197,14 @@ class BounceGIRenderEngine(bpy.types.RenderEngine):
             raise
         self.end_result(result)
 
-    def _report_done(self, pending, result) -> None:
+    def _report_done(self, pending, result, frame: int) -> None:
         self.update_progress(1.0)
         total = result.timings.get("total", pending.elapsed())
         self.update_stats("Bounce GI", f"{pending.method.upper()} {pending.width} x {pending.height} in "
                                        f"{total * 1000:.0f} ms")
+        # The render log (stdout, beside Blender's own "Fra:" lines): one line a frame, with what the engine's pass
+        # cache reused from the frame before (an animation renders through the one process-wide engine).
+        print(frame_log_line(frame, pending, result), flush=True)
         warnings = list(dict.fromkeys([*pending.scene_warnings, *result.warnings]))
         if warnings:
             more = f" (+{len(warnings) - 1} more)" if len(warnings) > 1 else ""

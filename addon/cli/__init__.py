@@ -48,7 +48,10 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("scene")
     r.add_argument("--method", choices=METHODS, help="default: none (with --budget-ms/--target-error: chosen)")
     r.add_argument("--res", nargs=2, type=int, metavar=("W", "H"))
-    r.add_argument("--out", help="output .exr (default: next to the .blend)")
+    r.add_argument("--out", help="output .exr (default: next to the .blend); with several --frames, #### in the "
+                                 "name becomes the frame number, e.g. DIR/frame_####.exr")
+    r.add_argument("--frames", metavar="A-B", help="render frames A to B (the animation as keyed), one EXR a frame, "
+                                                   "reusing what an unchanged input allows between frames")
     r.add_argument("--budget-ms", type=float, metavar="MS",
                    help="choose method and settings: the most accurate measured to fit this frame time")
     r.add_argument("--target-error", type=float, metavar="E",

@@ -8,40 +8,16 @@ from .options import parse_method_options, render_ours, vct_options
 
 
 def compare(scene, method: str, samples: int, bounces: int = 8, progress=progress, lpv_options=None,
-            vct_settings=None) -> dict:
-    """Render ours and the (cached) two-seed Cycles reference of the currently open scene; return the errors."""
-    import numpy as np
-
-    from ...gpu_kernels.output import metrics
+            vct_settings=None) -> tuple:
+    """Render ours and the (cached) two-seed Cycles reference of the currently open scene; return
+    (report, result, reference, mask) (addon/reference/compare.py)."""
+    from ..reference.compare import compare_result
     from ..reference.cycles import ReferenceSettings, render_reference
 
     result = render_ours(scene, method, lpv_options, vct_settings)
     ref_settings = ReferenceSettings(scene.resolution[0], scene.resolution[1], samples=samples, bounces=bounces)
     ref = render_reference(scene.content_hash(), ref_settings, progress=progress)
-    ours = result.passes
-    mask = (ours["Position"].any(axis=-1) | (ours["Depth"][..., 0] < 1e9)) & (ref.passes["Depth"][..., 0] < 1e9)
-    errors, floors = {}, {}
-    for name, key in (("Combined", "combined"), ("Diffuse Direct", "diffuse_direct"),
-                      ("Diffuse Indirect", "diffuse_indirect")):
-        errors[key] = metrics.rel_l1(ours[name], ref.passes[name], mask)
-        floors[key] = ref.noise_floor(name, mask)
-    col_diff = np.abs(ours["Diffuse Color"] - ref.passes["Diffuse Color"]).max(axis=-1)
-    report = {
-        "method": method,
-        "resolution": list(scene.resolution),
-        "rel_l1": errors,
-        "noise_floor": floors,
-        "rel_mse": metrics.rel_mse(ours["Combined"], ref.passes["Combined"], mask),
-        "diffuse_color_match": float(np.mean(col_diff[mask] < 0.01)) if mask.any() else float("nan"),
-        "seconds": {"ours": result.timings["total"], "cycles": ref.seconds, "cycles_cached": ref.cached},
-        "passes": {k: v for k, v in result.timings.items() if k != "total"},
-        "reference": {"samples": samples, "seeds": 2, "bounces": bounces},
-        "warnings": result.warnings + (["the world lights the scene in Cycles (Diffuse Direct), but method 'none' "
-                                        "does not render world light"] if max(scene.world.color) > 0 and
-                                       method == "none" else []),
-        "pixels_compared": int(mask.sum()),
-        "info": result.info,
-    }
+    report, mask = compare_result(scene, result, ref, method, samples, bounces)
     return report, result, ref, mask
 
 
@@ -54,9 +30,9 @@ def cmd_compare(args) -> dict:
     if heatmap:
         from ...gpu_kernels.output import exr as exr_io
         from ...gpu_kernels.output import metrics
+        from ..reference.compare import error_map
 
-        err = metrics.relative_error_map(result.passes["Combined"], ref.passes["Combined"]) * mask
-        write_output(exr_io.write_png, heatmap, metrics.heatmap_rgb8(err))
+        write_output(exr_io.write_png, heatmap, metrics.heatmap_rgb8(error_map(result, ref, mask)))
         report["heatmap"] = heatmap
     if not args.json:
         print(format_compare(report))

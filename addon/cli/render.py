@@ -1,10 +1,12 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""`bounce-gi render`: one .blend rendered from its scene camera into a multi-layer EXR, with per-pass timings."""
+"""`bounce-gi render`: one .blend rendered from its scene camera into a multi-layer EXR, with per-pass timings; with
+`--frames A-B` an animation, one EXR a frame (frames.py)."""
 from __future__ import annotations
 
 import os
 
 from ..scene_io import check_blend_path, check_output_path, load_scene, write_output
+from .frames import render_frames
 from .options import auto_quality, parse_method_options, render_ours, vct_options
 
 
@@ -13,6 +15,8 @@ def cmd_render(args) -> dict:
     args.method = args.method or "none"
     if quality and not args.json:
         print(quality["message"])
+    if args.frames is not None:
+        return render_frames(args, quality)
     if args.out:
         out = check_output_path(args.out, ".exr")
     else:

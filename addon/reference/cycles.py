@@ -4,7 +4,9 @@
 Settings: CPU, adaptive sampling off, denoising off, clamps 0, light threshold 0, pixel filter 0.01 px (so Cycles
 samples pixel centres like our rasteriser), fixed bounce counts. The mean of the two seeds is the reference; half
 the rel-L1 between the seeds is the reference's own noise floor, reported beside every error.
-The user's scene is restored after rendering (every touched setting is put back), so nothing is changed in the .blend.
+The user's scene is restored after rendering (every render, Cycles, image and view layer setting is put back as it
+was: settings_snapshot.py), so nothing is changed in the .blend. ReferenceJob renders seed by seed for callers that
+run Blender's render job themselves (the compare operator).
 """
 from __future__ import annotations
 
@@ -134,39 +136,109 @@ def settings_to_save(scene, view_layer):
 
 
 def render_reference(scene_hash: str, settings: ReferenceSettings, progress=None) -> Reference:
-    """Render (or load from cache) the two-seed Cycles reference of the current bpy scene."""
+    """Render (or load from cache) the two-seed Cycles reference of the current bpy scene, blocking."""
     import bpy
 
-    directory = cache_dir()
-    key = cache_key(scene_hash, settings)
-    meta_path = directory / f"{key}.json"
-    seed_paths = [directory / f"{key}_seed{s}.exr" for s in settings.seeds]
-    if meta_path.exists() and all(p.exists() for p in seed_paths):
-        try:
-            seeds = [exr_io.read_passes(str(p)) for p in seed_paths]
-            seconds = json.loads(meta_path.read_text())["seconds"]
-            return Reference(_mean(seeds), seeds, seconds, cached=True)
-        except (OSError, ValueError, KeyError):
-            pass  # a broken cache entry is simply rendered again
-    directory.mkdir(parents=True, exist_ok=True)
-    scene = bpy.context.scene
-    view_layer = bpy.context.view_layer
-    seeds, seconds = [], 0.0
-    with tempfile.TemporaryDirectory(prefix="bounce-gi-ref-") as tmp, saved_attributes(settings_to_save(scene, view_layer)):
-        for i, seed in enumerate(settings.seeds):
+    job = ReferenceJob(scene_hash, settings, bpy.context.scene, bpy.context.view_layer)
+    return job.cached if job.cached is not None else run_blocking(job, progress)
+
+
+def run_blocking(job: "ReferenceJob", progress=None) -> Reference:
+    """Render every seed of `job` with `bpy.ops.render.render` (blocking) and return the Reference; the scene's
+    render settings are restored whatever happens."""
+    import bpy
+
+    try:
+        while not job.done:
+            message = job.begin_seed()
             if progress:
-                progress(f"Cycles reference: seed {seed} ({i + 1}/{len(settings.seeds)}), "
-                         f"{settings.samples} samples at {settings.width}x{settings.height}")
-            out = os.path.join(tmp, f"seed{seed}.exr")
-            configure_cycles(scene, view_layer, settings, seed, out)
-            start = time.perf_counter()
+                progress(message)
             bpy.ops.render.render(write_still=True)
-            seconds += time.perf_counter() - start
-            passes = exr_io.read_passes(out)
-            seeds.append(passes)
-            exr_io.write_passes(str(seed_paths[i]), passes)
-    meta_path.write_text(json.dumps({"seconds": seconds, "settings": asdict(settings), "scene": scene_hash}))
-    return Reference(_mean(seeds), seeds, seconds, cached=False)
+            job.end_seed()
+        return job.finish()
+    finally:
+        job.restore()
+
+
+class ReferenceJob:
+    """A two-seed reference rendered one seed at a time, so the caller runs each seed's render: render_reference
+    blocks on `bpy.ops.render.render`, the compare operator starts Blender's render job and polls it.
+
+    `cached` is the Reference when the cache has it (nothing to render). Otherwise, per seed: `begin_seed()` (the
+    first call snapshots the scene's render settings, settings_snapshot.py, then Cycles is configured for the seed)
+    → render to `seed_path` → `end_seed()`; then `finish()`. `restore()` puts every render setting back exactly and
+    removes the temporary files; call it in a `finally` (it is idempotent), also after a cancelled render."""
+
+    def __init__(self, scene_hash: str, settings: ReferenceSettings, scene, view_layer):
+        self.settings, self.scene_hash, self.scene, self.view_layer = settings, scene_hash, scene, view_layer
+        self.directory = cache_dir()
+        key = cache_key(scene_hash, settings)
+        self.meta_path = self.directory / f"{key}.json"
+        self.cache_paths = [self.directory / f"{key}_seed{s}.exr" for s in settings.seeds]
+        self.cached = self._load_cached()
+        self.seeds, self.seconds = [], 0.0
+        self.seed_path = None  # where the current seed's render is written
+        self._snapshot, self._tmp, self._started, self._begun = None, None, 0.0, 0
+
+    def _load_cached(self) -> Reference | None:
+        if not (self.meta_path.exists() and all(p.exists() for p in self.cache_paths)):
+            return None
+        try:
+            seeds = [exr_io.read_passes(str(p)) for p in self.cache_paths]
+            seconds = json.loads(self.meta_path.read_text())["seconds"]
+        except (OSError, ValueError, KeyError):
+            return None  # a broken cache entry is simply rendered again
+        return Reference(_mean(seeds), seeds, seconds, cached=True)
+
+    @property
+    def started_seeds(self) -> int:
+        """Seeds begun so far (begin_seed calls); len(seeds) of them are rendered and read."""
+        return self._begun
+
+    @property
+    def done(self) -> bool:
+        return len(self.seeds) == len(self.settings.seeds)
+
+    def begin_seed(self) -> str:
+        """Configure Cycles for the next seed; returns a one-line description for progress."""
+        from .settings_snapshot import snapshot
+
+        if self._snapshot is None:
+            self._snapshot = snapshot(self.scene, self.view_layer)
+            self._tmp = tempfile.TemporaryDirectory(prefix="bounce-gi-ref-")
+        i = len(self.seeds)
+        seed = self.settings.seeds[i]
+        self.seed_path = os.path.join(self._tmp.name, f"seed{seed}.exr")
+        configure_cycles(self.scene, self.view_layer, self.settings, seed, self.seed_path)
+        self._started = time.perf_counter()
+        self._begun = i + 1
+        st = self.settings
+        return (f"Cycles reference: seed {seed} ({i + 1}/{len(st.seeds)}), {st.samples} samples at "
+                f"{st.width}x{st.height}")
+
+    def end_seed(self) -> None:
+        """Read the seed's render (written by the caller's render) and store it in the cache."""
+        self.seconds += time.perf_counter() - self._started
+        passes = exr_io.read_passes(self.seed_path)
+        self.directory.mkdir(parents=True, exist_ok=True)
+        exr_io.write_passes(str(self.cache_paths[len(self.seeds)]), passes)
+        self.seeds.append(passes)
+
+    def finish(self) -> Reference:
+        self.meta_path.write_text(json.dumps({"seconds": self.seconds, "settings": asdict(self.settings),
+                                              "scene": self.scene_hash}))
+        self.restore()
+        return Reference(_mean(self.seeds), self.seeds, self.seconds, cached=False)
+
+    def restore(self) -> None:
+        from .settings_snapshot import restore
+
+        snap, self._snapshot = self._snapshot, None
+        if snap is not None:
+            restore(snap)
+        tmp, self._tmp = self._tmp, None
+        if tmp is not None:
+            tmp.cleanup()
 
 
 def _mean(seeds: list) -> dict:

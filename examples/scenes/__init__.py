@@ -16,13 +16,15 @@ otherwise. Image textures are generated in code and packed into the .blend.
 The scenes live in modules by kind, built from the pieces in helpers.py:
 cornell_box.py (cornell, cornell_emissive), stage.py (the light_* scenes,
 textured, principled, camera_*), extraction_scene.py (extraction) and
-rooms.py (spot_room, courtyard). This module holds the registry, build()
+rooms.py (spot_room, courtyard), animated.py (cornell_animated: a
+change per frame). This module holds the registry, build()
 and save(), and re-exports the public names of those modules, so
 `scenes.<name>` reaches all of them.
 """
 
 import bpy  # must come before bmesh/mathutils: the bpy wheel puts them on the path
 
+from .animated import ANIMATED_FRAMES, cornell_animated
 from .cornell_box import (CORNELL_EMISSION_STRENGTH, CORNELL_GREEN, CORNELL_LIGHT_POWER,
                           CORNELL_LIGHT_SIZE, CORNELL_RED, CORNELL_WHITE, cornell, cornell_emissive)
 from .extraction_scene import CUSTOM_NORMAL, extraction
@@ -37,7 +39,8 @@ from .stage import (AREA_LOCATION, AREA_ROTATION, CUBE_LOCATION, POINT_LOCATION,
 
 RESOLUTION = (160, 120)
 
-__all__ = ["CORNELL_EMISSION_STRENGTH", "CORNELL_GREEN", "CORNELL_LIGHT_POWER", "CORNELL_LIGHT_SIZE", "CORNELL_RED",
+__all__ = ["ANIMATED_FRAMES", "cornell_animated",
+           "CORNELL_EMISSION_STRENGTH", "CORNELL_GREEN", "CORNELL_LIGHT_POWER", "CORNELL_LIGHT_SIZE", "CORNELL_RED",
            "CORNELL_WHITE", "cornell", "cornell_emissive", "CUSTOM_NORMAL", "extraction", "CHECKER_A", "CHECKER_B",
            "box", "camera", "checker_image", "diffuse_material", "emission_material", "light", "look_at_rotation",
            "mesh_object", "principled_material", "quad", "quad_faces", "reset", "set_world", "textured_material",
@@ -67,6 +70,7 @@ SCENES = {
     "extraction": extraction,
     "spot_room": spot_room,
     "courtyard": courtyard,
+    "cornell_animated": cornell_animated,
 }
 
 

@@ -359,3 +359,4 @@ def test_method_settings_reach_the_renderer(env, blends, tmp_path):
     report = json.loads(proc.stdout.strip().splitlines()[-1])
     cascade = report["info"]["cascades"][0]
     assert max(cascade["cells"]) == 8 and len(cascade["bounces"]) == 1
+

@@ -34,6 +34,7 @@ EXPECTED_COUNTS = {
     "extraction": (5, 1, 3, 0),
     "spot_room": (7, 1, 0, 0),
     "courtyard": (6, 1, 0, 0),
+    "cornell_animated": (7, 1, 0, 0),
 }
 
 

@@ -28,7 +28,7 @@ from examples import scenes
 
 zip_path, mod, tmp = sys.argv[1], sys.argv[2], sys.argv[3]
 BLEND = os.path.join(tmp, "scene.blend")
-scenes.save("cornell", BLEND)
+scenes.save(os.environ.get("CASE_SCENE", "cornell"), BLEND)   # the example scene a case renders
 print("install", bpy.ops.extensions.package_install_files(filepath=zip_path, repo="user_default",
                                                           enable_on_install=True))
 assert mod in bpy.context.preferences.addons, "extension not enabled"
@@ -160,6 +160,30 @@ def test_animation_writes_one_file_per_frame(linux_zip, tmp_path):
         print("mean Diffuse Direct per frame", means)
         assert means[0] > 0 and means[0] < means[1] < means[2], means   # each frame's own light energy
     """)
+
+
+def test_animation_reuses_the_engine_between_frames(linux_zip, tmp_path):
+    # `-a` on cornell_animated (examples/scenes/animated.py): the light moves at frame 2, the camera at frame 3.
+    # Blender calls render() once a frame; the one process-wide engine keeps its pass cache, and each frame's log
+    # line says what it reused.
+    out, _ = run_case(linux_zip, tmp_path, """
+        scene = open_blend(method="LPV", size=(32, 24))
+        scene.bounce_gi.quality = "DRAFT"
+        scene.frame_start, scene.frame_end = 1, 3
+        scene.render.filepath = os.path.join(tmp, "anim_")
+        engine = ext("gpu_kernels.engine").get_engine()
+        bpy.ops.render.render(animation=True)
+        assert ext("gpu_kernels.engine").get_engine() is engine, "a new engine: nothing could be reused"
+        files = sorted(f for f in os.listdir(tmp) if f.startswith("anim_"))
+        print("files", files)
+        assert files == ["anim_0001.exr", "anim_0002.exr", "anim_0003.exr"], files
+    """, env={"CASE_SCENE": "cornell_animated"})
+    lines = [line for line in out.splitlines() if line.startswith("Bounce GI: frame ")]
+    assert len(lines) == 3, out
+    reused = [set(line.partition("; reused ")[2].split(", ")) for line in lines]
+    assert reused[0] == {"nothing"}, lines
+    assert {"geometry", "textures", "gbuffer"} <= reused[1] and "shadow_maps" not in reused[1], lines
+    assert {"geometry", "textures", "shadow_maps"} <= reused[2] and "gbuffer" not in reused[2], lines
 
 
 def test_disable_enable_stops_the_worker_and_renders_again(linux_zip, tmp_path):

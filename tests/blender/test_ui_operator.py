@@ -135,6 +135,28 @@ def test_panels_draw_with_valid_names(tmp_path):
     """)
 
 
+def test_compare_panel_draws_the_last_report(tmp_path):
+    run_case(tmp_path, RECORDING_LAYOUT + """
+        from bounce_gi.ui import compare
+        ctx = SimpleNamespace(scene=bpy.context.scene)
+        compare.state.last = {"method": "lpv", "resolution": [32, 24], "reference": {"samples": 16},
+                              "rel_l1": {"combined": 0.12, "diffuse_direct": 0.026, "diffuse_indirect": 0.25},
+                              "noise_floor": {"combined": 0.1, "diffuse_direct": 0.003, "diffuse_indirect": 0.22},
+                              "rel_mse": 0.01, "diffuse_color_match": 0.99,
+                              "seconds": {"ours": 2.1, "cycles": 0.7, "cycles_cached": False}, "warnings": ["w1"]}
+        for busy in (False, True):
+            compare.state.busy, compare.state.status = busy, "Cycles reference: seed 1" if busy else ""
+            panel.VIEW3D_PT_bounce_gi_compare.draw(SimpleNamespace(layout=Layout()), ctx)
+        print(seen)
+        assert ("op", "bounce_gi.compare_cycles") in seen and ("prop", "compare_samples") in seen
+        assert {("label", "Diffuse Indirect"), ("label", "0.250"), ("label", "0.220"), ("label", "w1"),
+                ("label", "Cycles reference: seed 1")} <= set(seen)
+        compare.state.busy = False
+        bpy.ops.wm.read_homefile(use_empty=True)   # another file: its errors would mislead
+        assert compare.state.last is None
+    """)
+
+
 TINY_SCENE = """
 for ob in list(bpy.data.objects):
     bpy.data.objects.remove(ob)
