@@ -125,7 +125,7 @@ class Pipeline:
     def __init__(self, ctx):
         self.ctx = ctx
         self.programs = ProgramCache(ctx)
-        self.cache = PassCache(finish=ctx.finish)
+        self.cache = PassCache(finish=ctx.finish, keep={**lpv_passes.KEEP, **vct_passes.KEEP})
 
     def render(self, scene: Scene, settings: RenderSettings) -> RenderResult:
         check_renderable(scene, settings)

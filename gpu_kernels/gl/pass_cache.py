@@ -32,19 +32,31 @@ class _Entry:
 
 @dataclass
 class PassCache:
-    """Runs passes, caches their outputs by key and records seconds per pass for the current frame."""
+    """Runs passes, caches their outputs by key and records seconds per pass for the current frame.
+
+    A pass keeps one output (`entries[name]`, the newest), or up to `keep[name]` of them: the live viewport
+    alternates a draft and a final setting, whose geometry-bound outputs (the LPV's transfer) would otherwise
+    evict each other on every edit."""
     finish: object = None  # callable that waits for the GPU (ctx.finish) so timings are honest
     entries: dict = field(default_factory=dict)
     timings: dict = field(default_factory=dict)
     skipped: list = field(default_factory=list)
+    keep: dict = field(default_factory=dict)  # pass name → outputs kept (default 1)
+    older: dict = field(default_factory=dict)  # pass name → outputs kept besides the newest, newest first
 
     def begin_frame(self) -> None:
         self.timings = {}
         self.skipped = []
 
     def run(self, name: str, key: tuple, fn):
-        """Return the cached output of `name` if `key` matches, else run `fn()` (timed) and cache it."""
+        """Return the cached output of `name` if `key` matches one kept, else run `fn()` (timed) and cache it."""
         entry = self.entries.get(name)
+        if entry is None or entry.key != key:
+            found = next((e for e in self.older.get(name, []) if e.key == key), None)
+            if found is not None:
+                self.older[name].remove(found)
+                self._retire(name, entry)
+                self.entries[name] = entry = found
         if entry is not None and entry.key == key:
             self.timings[name] = 0.0
             self.skipped.append(name)
@@ -55,11 +67,21 @@ class PassCache:
             self.finish()
         self.timings[name] = time.perf_counter() - start
         if entry is not None and entry.value is not value:
-            release_resources(entry.value)
+            self._retire(name, entry)
         self.entries[name] = _Entry(key, value)
         return value
 
+    def _retire(self, name: str, entry) -> None:
+        """Keep a replaced output among the `keep[name] - 1` older ones, releasing what falls off the end."""
+        if entry is None:
+            return
+        older = self.older.setdefault(name, [])
+        older.insert(0, entry)
+        while len(older) > self.keep.get(name, 1) - 1:
+            release_resources(older.pop().value)
+
     def clear(self) -> None:
-        for entry in self.entries.values():
+        for entry in list(self.entries.values()) + [e for es in self.older.values() for e in es]:
             release_resources(entry.value)
         self.entries.clear()
+        self.older.clear()

@@ -12,9 +12,10 @@ absorbed light → irradiance. Every scale is derived, none tuned (see the shade
   over all surfaces this is exactly the injected flux that did not leave the grid (lpv/occlusion.py); the
   classic lookup, SH intensity convolved with the cosine / cell², is `lookup="intensity"`;
 - bounces: absorbed light × albedo is injected again;
-- transport (default "gather", lpv/gather.py): every surface voxel gathers the VPLs' light directly, bounce by
-  bounce, with fuzzy visibility — the face scheme turns light sideways within a few cells; "propagate" is the
-  classic LPV above. World light propagates either way.
+- transport (default "transfer", lpv/transfer.py): every surface voxel gathers the light of clusters of surface
+  voxels directly, with fuzzy visibility, through a kernel cached per geometry (light, material and world edits
+  re-run no visibility); "gather" (lpv/gather.py) re-makes its VPL lists every bounce; "propagate" is the classic
+  LPV above — the face scheme turns light sideways within a few cells. World light propagates in all three.
 
 Iterations stop adaptively once a step moves less than `epsilon` of the injected flux.
 """

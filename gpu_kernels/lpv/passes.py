@@ -30,6 +30,10 @@ from ..voxel.voxelize import scene_area
 from . import clusters, gather, inject, lighting, occlusion, octree, propagate, rsm, transfer
 from .state import LpvGridState, cascade_grids
 
+# Outputs kept per pass (gl/pass_cache.py): the geometry's passes for two settings (the live viewport's draft and
+# final stages use two grids; each would otherwise rebuild its transfer on every edit).
+KEEP = {name: 2 for name in ("geometry_volume", "lpv_albedo", "lpv_transfer", "lpv_transfer_albedo", "lpv_world")}
+
 
 def run(frame) -> MethodOutput:
     """Run (or reuse) the LPV passes of one frame; `frame` is the pipeline's FrameInputs."""

@@ -16,6 +16,9 @@ from ..common.method import MethodOutput
 from . import bounce, inject, mipmap, specular, temporal, trace, upsample
 from .volumes import mip_levels, vct_grid, voxelize_scene
 
+# Outputs kept per pass (gl/pass_cache.py): the voxels of two grids (the live viewport's draft and final stages).
+KEEP = {"vct_voxelize": 2}
+
 
 def run(frame) -> MethodOutput:
     """Run (or reuse) the VCT passes of one frame; `frame` is the pipeline's FrameInputs. The output's indirect

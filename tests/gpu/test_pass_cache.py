@@ -268,3 +268,19 @@ def test_pipeline_reruns_only_what_changed(engine, settings):
     world.world.color = (0.1, 0.2, 0.3)
     fifth = engine.render(world, settings)
     assert set(fifth.skipped) == ALL_PASSES - {"compose"}
+
+
+def test_a_pass_keeps_as_many_outputs_as_asked_and_releases_the_rest():
+    """keep = 2: alternating two keys (the viewport's draft and final settings) re-runs neither after the first
+    time; a third key evicts the least recently used one, which is released exactly once."""
+    cache, c = PassCache(keep={"t": 2}), Counter()
+    a, b, third = Resource("a"), Resource("b"), Resource("c")
+    for key, value in (("A", a), ("B", b), ("A", None), ("B", None), ("A", None)):
+        cache.begin_frame()
+        got = cache.run("t", (key,), c.fn("t", value))
+        assert got is {"A": a, "B": b}[key]
+    assert c.calls["t"] == 2 and cache.skipped == ["t"]
+    cache.run("t", ("C",), c.fn("t", third))  # A is newest, B the older one: B goes
+    assert b.released == 1 and a.released == 0 and third.released == 0
+    cache.clear()
+    assert a.released == 1 and third.released == 1 and b.released == 1
