@@ -111,6 +111,17 @@ def indirect_image(out, shape) -> np.ndarray:
     return read_texture(out.indirect, 3)[::-1]
 
 
+def method_info(out, frame) -> dict:
+    """The method's details (RenderResult.info), with "skipped_work": the lights that cannot light the scene and
+    what the method left out."""
+    info = dict(out.info) if out else {}
+    lights = list(frame.shadows.buffers.skipped or [])
+    info["skipped_work"] = lights + list(info.get("skipped_work", []))
+    if out is None and frame.settings.method == "none":
+        info["skipped_work"].append("indirect light: method none")
+    return info
+
+
 def surface_base(scene: Scene, atlas: SurfaceAtlas) -> np.ndarray:
     return sgb.base_colors(scene, atlas, sgb.surface_points(scene, atlas))
 
@@ -149,7 +160,7 @@ class Pipeline:
         return RenderResult(passes=passes, timings=timings, skipped=list(self.cache.skipped),
                             warnings=list(scene.warnings) + list(frame.shadows.warnings),
                             statistics=scene.statistics(), method=settings.method,
-                            resolution=(settings.width, settings.height), info=out.info if out else {})
+                            resolution=(settings.width, settings.height), info=method_info(out, frame))
 
     def render_surface(self, scene: Scene, settings: RenderSettings, atlas: SurfaceAtlas,
                        indirect_atlas: SurfaceAtlas | None = None) -> SurfaceLight:
@@ -173,7 +184,7 @@ class Pipeline:
         timings["total"] = time.perf_counter() - start
         return SurfaceLight(atlas, direct, indirect, base, draw_arrays(scene, atlas, indirect_atlas), timings,
                             list(self.cache.skipped), list(scene.warnings) + list(frame.shadows.warnings),
-                            settings.method, scene.statistics(), out.info if out else {}, indirect_atlas,
+                            settings.method, scene.statistics(), method_info(out, frame), indirect_atlas,
                             indirect_base)
 
     def render_points(self, scene: Scene, settings: RenderSettings, positions, normals) -> PointLight:

@@ -64,6 +64,7 @@ class LightBuffers:
     polygon_vertices: np.ndarray  # (V, 4) float32
     warnings: list
     view_lights: list = None  # index of the light record each view belongs to
+    skipped: list = None  # lights left out because they cannot light the scene, in words (skipped_work)
 
 
 def _color(light: Light) -> np.ndarray:
@@ -197,6 +198,7 @@ class _Records:
 
     def __init__(self):
         self.records, self.views, self.polys, self.warnings, self.view_lights = [], [], [], [], []
+        self.skipped = []
 
     def add(self, type_, color, position=(0, 0, 0), radius=0.0, direction=(0, 0, -1), cos_half=0.0, smooth=0.0,
             light_views=(), samples=0, per=0, poly=None, two_sided=False):
@@ -216,7 +218,7 @@ class _Records:
         lights = np.array(self.records, LIGHT_DTYPE) if self.records else np.zeros(0, LIGHT_DTYPE)
         vertices = np.concatenate(self.polys) if self.polys else np.zeros((0, 3))
         vertices = np.concatenate([vertices, np.ones((len(vertices), 1))], axis=1).astype(np.float32)
-        return LightBuffers(lights, self.views, vertices, self.warnings, self.view_lights)
+        return LightBuffers(lights, self.views, vertices, self.warnings, self.view_lights, self.skipped)
 
 
 def build_light_buffers(scene: Scene, settings: ShadowSettings | None = None) -> LightBuffers:
@@ -224,9 +226,27 @@ def build_light_buffers(scene: Scene, settings: ShadowSettings | None = None) ->
     s = settings or ShadowSettings()
     out = _Records()
     for light in scene.lights:
+        reason = unreachable(scene, light)
+        if reason:
+            out.skipped.append(f"light '{light.name}': {reason}")
+            continue
         _add_lamp(out, scene, light, s)
     _add_emissive(out, scene, s)
     return out.finish()
+
+
+def unreachable(scene: Scene, light: Light) -> str:
+    """Why a light cannot light the scene, or "": no power or no colour, or a one-sided area light whose whole
+    side faces away from every point of the scene's bounds (exact: its light leaves through its back)."""
+    if not light.power > 0 or max(_color(light)) <= 0:
+        return "zero power"
+    if light.type == "AREA" and len(scene.positions):  # Blender's area lights emit from their front only
+        lo, hi = scene.bounds()
+        corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+        origin = np.asarray(light.matrix_world, np.float64)[:3, 3]
+        if ((corners - origin) @ np.asarray(light.direction, np.float64)).max() <= 0:
+            return "faces away from the whole scene"
+    return ""
 
 
 def _add_lamp(out: _Records, scene: Scene, light: Light, s: ShadowSettings) -> None:
