@@ -118,9 +118,11 @@ def neighbour_pairs(cells: np.ndarray, sides: np.ndarray, size: tuple) -> np.nda
     return np.concatenate(out) if out else np.zeros((0, 2), np.int64)
 
 
-def make_clusters(cells: np.ndarray, normals: np.ndarray, areas: np.ndarray, fine: Grid, budget: int) -> Clusters:
+def make_clusters(cells: np.ndarray, normals: np.ndarray, areas: np.ndarray, fine: Grid, budget: int,
+                  block: int | None = None) -> Clusters:
     """Cluster the surface voxels' sides (cells (R, 3) xyz, mean normals (R, 3), areas (R,)) into at most
-    `budget` clusters: the smallest block side S (from 2) whose blocks × sides × planes fit. Sides facing
+    `budget` clusters: the smallest block side S (from 2) whose blocks × sides × planes fit, or S = `block` (an
+    update after an edit keeps the blocks it had, so clusters away from the edit stay the same). Sides facing
     nothing (`faces_something`) get none."""
     lengths = np.linalg.norm(normals, axis=1)
     valid = (areas > 0) & (lengths > 0)
@@ -133,12 +135,12 @@ def make_clusters(cells: np.ndarray, normals: np.ndarray, areas: np.ndarray, fin
     use = np.nonzero(emits)[0]
     offset = np.einsum("ij,ij->i", side_n[use], pos[use])
     pairs = neighbour_pairs(cells[use // 2], side_of(side_n[use]), fine.size)
-    block = 2
+    fixed, block = block is not None, block or 2
     while True:
         key = block_keys(pos[use], side_n[use], fine, block)
         index = _group(key, offset, 0.5 * fine.cell, pairs, max(2, block * block // 8))
         count = int(index.max()) + 1 if len(index) else 0
-        if count <= budget or block >= max(fine.size):
+        if fixed or count <= budget or block >= max(fine.size):
             break
         block += 1
     sides = np.full(2 * len(cells), -1, np.int64)

@@ -120,8 +120,10 @@ def _transfer(frame, grids, k_grids, maps, k_rsm, budget) -> MethodOutput:
         gv.surface_albedo if gv.materials_key == materials else
         occlusion.surface_albedo(ctx, programs, scene, frame.geometry, frame.textures, gv) for gv in gvs])
     k_tr = (k_gv, budget, s.occlusion)
-    transfers = cache.run("lpv_transfer", k_tr, lambda: [_build(ctx, programs, gv, grid, budget, s)
-                                                         for gv, grid in zip(gvs, grids)])
+    prior = cache.entries.get("lpv_transfer")  # an edit of the geometry updates it (transfer.update_transfer)
+    priors = prior.value if prior is not None and prior.key[1:] == k_tr[1:] else [None] * len(gvs)
+    transfers = cache.run("lpv_transfer", k_tr, lambda: [_build(ctx, programs, gv, grid, budget, s, p)
+                                                         for gv, grid, p in zip(gvs, grids, priors)])
     weights = [a * gv.surface_area[:, None] for a, gv in zip(albedo, gvs)]
     k_m = (k_tr, k_albedo)
     m_rho = cache.run("lpv_transfer_albedo", k_m, lambda: [
@@ -161,13 +163,18 @@ def skipped_work(stats: list, s) -> list:
     return out
 
 
-def _build(ctx, programs, gv, grid, budget, s) -> transfer.Transfer:
-    """Clusters and T of one cascade; the budget re-checked against its real surface-voxel count."""
+def _build(ctx, programs, gv, grid, budget, s, prior=None) -> transfer.Transfer:
+    """Clusters and T of one cascade: updated from `prior` (the same grid before a geometry edit) where that
+    re-evaluates under half of T, else made anew with the budget re-checked against the real surface-voxel count."""
+    if prior is not None and prior.grid == grid:
+        sources, matrix, share = transfer.update_transfer(ctx, programs, gv, grid, s.occlusion, prior)
+        if share < 0.5:
+            return transfer.sort_by_cluster(sources, matrix, gv, grid, share)
     fits = int(s.transfer_mb * 2 ** 20 / (8 * max(gv.surface_count, 1)))
     sources = clusters.make_clusters(gv.cells, gv.surface_normal, gv.surface_area, gv.fine,
                                      max(transfer.MIN_CLUSTERS, min(budget, fits)))
     matrix = transfer.build_transfer(ctx, programs, gv, grid, sources, s.occlusion)
-    return transfer.sort_by_cluster(sources, matrix)
+    return transfer.sort_by_cluster(sources, matrix, gv, grid)
 
 
 def _sky(ctx, programs, gv, grid, s) -> np.ndarray:
@@ -194,7 +201,8 @@ def _solve(ctx, gvs, grids, transfers, m_rho, weights, worlds, sources, s) -> di
         valid = (gv.surface_area > 0) & (np.linalg.norm(gv.surface_normal, axis=1) > 0)
         surfaces.append(transfer.upload_sides(ctx, grid, gv.fine, gv.cells, valid, sides))
         stats.append({"cells": list(grid.size), "cell": grid.cell, "transport": "transfer",
-                      "clusters": t.clusters.count, "block": t.clusters.block, "transfer_mb": t.nbytes / 2 ** 20, "injected_flux": float(first.sum()),
+                      "clusters": t.clusters.count, "block": t.clusters.block, "transfer_mb": t.nbytes / 2 ** 20,
+                      "transfer_updated": t.updated, "injected_flux": float(first.sum()),
                       "escaped_flux": unbinned, "world": world is not None,
                       "bounces": [{"flux": f} for f in passes], "bounces_used": len(passes)})
     return {"surfaces": surfaces, "stats": stats}

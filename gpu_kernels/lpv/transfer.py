@@ -36,10 +36,11 @@ from .gather import vpls_per_dispatch
 MIN_CLUSTERS = 64  # fewer sources than this blur a room's bounce into a few blobs: gather instead
 
 
-def build_transfer(ctx, programs, gv, grid: Grid, clusters: Clusters, occlusion: bool) -> np.ndarray:
+def build_transfer(ctx, programs, gv, grid: Grid, clusters: Clusters, occlusion: bool, update=None) -> np.ndarray:
     """T: (2, C, R) float32 — what cluster c of unit flux gives receiver r's front (0) and back (1) side, the kernel
     of lpv/gather.glsl evaluated on the GPU (MODE_TRANSFER), in dispatches of at most vpls_per_dispatch sources
-    and 64 MiB."""
+    and 64 MiB. With `update` = (fresh receivers (R,) bool, fresh clusters (C,) bool, box (2, 3)), only pairs with
+    a fresh end or a ray through the box are evaluated; the rest come back NaN (update_transfer fills them)."""
     r, c = int(gv.surface_count), clusters.count
     out = np.zeros((2, c, r), np.float32)
     if r == 0 or c == 0:
@@ -51,9 +52,19 @@ def build_transfer(ctx, programs, gv, grid: Grid, clusters: Clusters, occlusion:
     set_uniform(prog, "u_fine_origin", tuple(float(v) for v in gv.fine.origin))
     set_uniform(prog, "u_surface_count", r)
     bind_grid(prog, grid)
-    sources = ctx.buffer(clusters.records.tobytes())
+    records, receivers = clusters.records.copy(), None
+    set_uniform(prog, "u_update", update is not None)
+    if update is not None:
+        fresh_receivers, fresh_clusters, box = update
+        records["flux"][:, 3] = fresh_clusters
+        cells = np.zeros((r, 4), np.int32)
+        cells[:, :3], cells[:, 3] = gv.cells, fresh_receivers
+        receivers = ctx.buffer(cells.tobytes())
+        set_uniform(prog, "u_box_lo", tuple(float(v) for v in box[0]))
+        set_uniform(prog, "u_box_hi", tuple(float(v) for v in box[1]))
+    sources = ctx.buffer(records.tobytes())
     sources.bind_to_storage_buffer(6)
-    gv.surfaces.bind_to_storage_buffer(7)
+    (receivers or gv.surfaces).bind_to_storage_buffer(7)
     chunk = max(1, min(vpls_per_dispatch(grid), (64 << 20) // (8 * r)))
     rows = ctx.buffer(reserve=min(chunk, c) * r * 8)
     rows.bind_to_storage_buffer(8)
@@ -66,9 +77,57 @@ def build_transfer(ctx, programs, gv, grid: Grid, clusters: Clusters, occlusion:
         block = np.frombuffer(rows.read(size=count * r * 8), np.float32).reshape(count, r, 2)
         out[0, first:first + count] = block[..., 0]
         out[1, first:first + count] = block[..., 1]
-    rows.release()
-    sources.release()
+    for buffer in (rows, sources, receivers):
+        if buffer is not None:
+            buffer.release()
     return out
+
+
+def _match(old: np.ndarray, new: np.ndarray) -> np.ndarray:
+    """For each row of `new` (structured or 2-D), the index of an identical row of `old`, or −1."""
+    old_keys = {row.tobytes(): i for i, row in enumerate(old)}
+    return np.array([old_keys.get(row.tobytes(), -1) for row in new], np.int64)
+
+
+def changed_box(prior, gv, grid: Grid):
+    """The box (2, 3) around every fine voxel that differs between `prior`'s receivers and `gv`'s (appeared,
+    vanished, or another normal or area), grown by an LPV cell (a cell's visibility planes come from the voxels in
+    it); None when nothing changed."""
+    def voxels(cells, normals, areas):
+        return np.concatenate([cells.astype(np.float64), normals, areas[:, None]], axis=1)
+    old = voxels(prior.cells, prior.normals, prior.areas)
+    new = voxels(gv.cells, gv.surface_normal, gv.surface_area)
+    gone = old[_match(new, old) < 0, :3]
+    came = new[_match(old, new) < 0, :3]
+    moved = np.concatenate([gone, came])
+    if len(moved) == 0:
+        return None
+    centre = np.asarray(gv.fine.origin) + (moved + 0.5) * gv.fine.cell
+    return np.stack([centre.min(axis=0) - grid.cell, centre.max(axis=0) + grid.cell])
+
+
+def update_transfer(ctx, programs, gv, grid: Grid, occlusion: bool, prior) -> tuple:
+    """T after a geometry edit, from `prior` (the Transfer before it): the clusters re-made with the same blocks,
+    and only the pairs the edit can change re-evaluated — a new receiver or source, or a ray through the changed
+    box. Returns (clusters, matrix, the share of pairs re-evaluated)."""
+    from .clusters import make_clusters
+
+    new = make_clusters(gv.cells, gv.surface_normal, gv.surface_area, gv.fine, 0, block=prior.clusters.block)
+    old_r = _match(np.concatenate([prior.cells, prior.normals, prior.areas[:, None]], axis=1),
+                   np.concatenate([gv.cells, gv.surface_normal, gv.surface_area[:, None]], axis=1))
+    old_c = _match(prior.clusters.records, new.records)
+    box = changed_box(prior, gv, grid)
+    if box is None:
+        box = np.zeros((2, 3))
+    matrix = build_transfer(ctx, programs, gv, grid, new, occlusion, (old_r < 0, old_c < 0, box))
+    keep = np.isnan(matrix)
+    share = 1.0 - keep.mean()
+    for side in range(2):  # the kept pairs' old values: prior's columns are sorted by cluster, undo that
+        position = np.empty(len(prior.order[side]), np.int64)
+        position[prior.order[side]] = np.arange(len(position))
+        old = prior.matrix[side][np.maximum(old_c, 0)][:, position[np.maximum(old_r, 0)]]
+        np.copyto(matrix[side], old, where=keep[side])
+    return new, matrix, share
 
 
 def reflect(clusters: Clusters, weight: np.ndarray, irradiance: np.ndarray) -> np.ndarray:
@@ -87,19 +146,27 @@ def reflect(clusters: Clusters, weight: np.ndarray, irradiance: np.ndarray) -> n
 class Transfer:
     """One cascade's cached transport: its clusters and T, each side's columns in the order of that side's
     clusters (`order[s]`: receiver of each column; the receivers whose side has no cluster last), so that a
-    cluster's receivers are one contiguous slice (`starts[s]`) for albedo_transfer."""
+    cluster's receivers are one contiguous slice (`starts[s]`) for albedo_transfer; and the receivers it was made
+    for (update_transfer compares them with the next geometry's)."""
     clusters: Clusters
     matrix: np.ndarray  # (2, C, R) float32
     order: list  # per side: (R,) receiver index of each column
     starts: list  # per side: (C + 1,) first column of each cluster; columns past starts[s][-1] have none
+    grid: Grid = None
+    cells: np.ndarray = None  # (R, 3) the receivers' fine voxels, their normals and areas
+    normals: np.ndarray = None
+    areas: np.ndarray = None
+    updated: float = 1.0  # the share of T evaluated when it was made (1: all of it; less after an edit)
 
     @property
     def nbytes(self) -> int:
         return self.matrix.nbytes
 
 
-def sort_by_cluster(clusters: Clusters, matrix: np.ndarray) -> Transfer:
-    """`matrix` (2, C, R) in receiver order → a Transfer with each side's columns grouped by cluster."""
+def sort_by_cluster(clusters: Clusters, matrix: np.ndarray, gv=None, grid: Grid | None = None,
+                    updated: float = 1.0) -> Transfer:
+    """`matrix` (2, C, R) in receiver order → a Transfer with each side's columns grouped by cluster (and the
+    receivers of `gv` recorded)."""
     order, starts, out = [], [], np.empty_like(matrix)
     for side in range(2):
         members = clusters.side_cluster[:, side]
@@ -108,7 +175,10 @@ def sort_by_cluster(clusters: Clusters, matrix: np.ndarray) -> Transfer:
         out[side] = matrix[side][:, perm]
         order.append(perm)
         starts.append(np.searchsorted(key[perm], np.arange(clusters.count + 1)))
-    return Transfer(clusters, out, order, starts)
+    if gv is None:
+        return Transfer(clusters, out, order, starts, updated=updated)
+    return Transfer(clusters, out, order, starts, grid, gv.cells.copy(), gv.surface_normal.copy(),
+                    gv.surface_area.copy(), updated)
 
 
 def albedo_transfer(t: Transfer, weight: np.ndarray) -> np.ndarray:

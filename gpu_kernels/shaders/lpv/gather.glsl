@@ -42,6 +42,20 @@ uniform float u_grid_cell;
 uniform ivec3 u_grid_size;
 #if defined(MODE_TRANSFER)
 layout(std430, binding = 8) writeonly buffer Transfer { vec2 transfer[]; };  // lpv/transfer.py
+// An update after an edit (lpv/transfer.update_transfer): only pairs whose receiver or source is new (w / flux.w
+// set) or whose ray passes through the changed box are evaluated; the others are marked NaN and keep their value.
+uniform bool u_update;
+uniform vec3 u_box_lo;
+uniform vec3 u_box_hi;
+
+bool crosses_box(vec3 a, vec3 b) {  // the segment a → b meets the box (slab test)
+    vec3 d = b - a;
+    vec3 inv = vec3(d.x != 0.0 ? 1.0 / d.x : 1e30, d.y != 0.0 ? 1.0 / d.y : 1e30, d.z != 0.0 ? 1.0 / d.z : 1e30);
+    vec3 t0 = (u_box_lo - a) * inv, t1 = (u_box_hi - a) * inv;
+    float enter = max(max(min(t0.x, t1.x), min(t0.y, t1.y)), min(t0.z, t1.z));
+    float leave = min(min(max(t0.x, t1.x), max(t0.y, t1.y)), max(t0.z, t1.z));
+    return enter <= leave && leave >= 0.0 && enter <= 1.0;
+}
 #else
 layout(rgba32f, binding = 0) uniform image3D u_front;  // this bounce: rgb irradiance (W/m²), a = 1 if surface
 layout(rgba32f, binding = 1) uniform image3D u_back;
@@ -154,9 +168,12 @@ void main() {
     vec3 p = u_fine_origin + (vec3(f) + 0.5) * h;
 #if defined(MODE_TRANSFER)
     // One row per source of this dispatch: transfer[(j − first) · surfaces + receiver] = (front, back).
-    for (int j = u_vpl_first; j < u_vpl_first + u_vpl_count; ++j)
+    bool fresh_receiver = !u_update || surfaces[gl_GlobalInvocationID.x].w != 0;
+    for (int j = u_vpl_first; j < u_vpl_first + u_vpl_count; ++j) {
+        bool fresh = fresh_receiver || vpls[j].flux.w != 0.0 || crosses_box(vpls[j].position.xyz, p);
         transfer[(j - u_vpl_first) * u_surface_count + int(gl_GlobalInvocationID.x)] =
-            receives ? vpl_kernel(vpls[j], p, nv, h) : vec2(0.0);
+            !fresh ? vec2(uintBitsToFloat(0x7fc00000u)) : receives ? vpl_kernel(vpls[j], p, nv, h) : vec2(0.0);
+    }
 #else
     if (!receives) return;
     vec3 front = vec3(0.0), back = vec3(0.0);
