@@ -71,6 +71,12 @@ class PassCache:
         self.entries[name] = _Entry(key, value)
         return value
 
+    def kept(self, name: str) -> list:
+        """The outputs kept for `name` as (key, value), newest first (a pass may update one instead of starting
+        over: the LPV's transfer after a geometry edit)."""
+        entries = ([self.entries[name]] if name in self.entries else []) + self.older.get(name, [])
+        return [(e.key, e.value) for e in entries]
+
     def _retire(self, name: str, entry) -> None:
         """Keep a replaced output among the `keep[name] - 1` older ones, releasing what falls off the end."""
         if entry is None:

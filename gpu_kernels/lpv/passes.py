@@ -106,6 +106,32 @@ def transfer_estimate(scene, s) -> dict:
 def _transfer(frame, grids, k_grids, maps, k_rsm, budget) -> MethodOutput:
     """The cached transport's passes (lpv/transfer.py); see the module docstring for what each reads."""
     ctx, programs, cache, scene, s = frame.ctx, frame.programs, frame.cache, frame.scene, frame.settings.lpv
+    gvs, transfers, weights, m_rho, keys = _transfer_geometry(frame, grids, k_grids, budget)
+    world = tuple(float(c) for c in scene.world.color[:3])
+    worlds = [None] * len(gvs)  # a black world: nothing to propagate (a sky it lit before stays cached)
+    if max(world) > 0:
+        k_sky = (keys["gv"], s.max_iterations, s.epsilon, s.clamp_negative)
+        skies = cache.run("lpv_world", k_sky, lambda: [_sky(ctx, programs, gv, grid, s)
+                                                       for gv, grid in zip(gvs, grids)])
+        worlds = [sky[..., None] * np.asarray(world) for sky in skies]
+    k_src = (k_rsm, keys["transfer"])
+    sources = cache.run("lpv_inject", k_src, lambda: [clusters.bin_flux(t.clusters, gather.rsm_records(
+        ctx, programs, maps, frame.shadows, grid, budget)[0]) for t, grid in zip(transfers, grids)])
+    k_prop = (k_src, keys["albedo_transfer"], keys["gv"], world, s.max_iterations, s.clamp_negative, s.bounces,
+              s.epsilon)
+    solved = cache.run("lpv_propagate", k_prop, lambda: _solve(ctx, gvs, grids, transfers, m_rho, weights, worlds,
+                                                               sources, s))
+    k_light = (frame.keys["gbuffer"], k_prop)
+    indirect = cache.run("lpv_lighting", k_light,
+                         lambda: lighting.lighting(ctx, programs, frame.gbuffer, solved["surfaces"], gvs, s))
+    return MethodOutput(indirect, None, k_light, {"cascades": solved["stats"],
+                                                  "skipped_work": skipped_work(solved["stats"], s)})
+
+
+def _transfer_geometry(frame, grids, k_grids, budget) -> tuple:
+    """The geometry's passes of the cached transport: geometry volume, albedo, T (updated from a kept T of the same
+    grid after a geometry edit) and M_ρ; returns (gvs, transfers, albedo × area per cascade, M_ρ, their keys)."""
+    ctx, programs, cache, scene, s = frame.ctx, frame.programs, frame.cache, frame.scene, frame.settings.lpv
     materials = frame.keys["materials"]
     k_gv = (frame.keys["geometry"], k_grids, "geometry only")
 
@@ -120,33 +146,15 @@ def _transfer(frame, grids, k_grids, maps, k_rsm, budget) -> MethodOutput:
         gv.surface_albedo if gv.materials_key == materials else
         occlusion.surface_albedo(ctx, programs, scene, frame.geometry, frame.textures, gv) for gv in gvs])
     k_tr = (k_gv, budget, s.occlusion)
-    prior = cache.entries.get("lpv_transfer")  # an edit of the geometry updates it (transfer.update_transfer)
-    priors = prior.value if prior is not None and prior.key[1:] == k_tr[1:] else [None] * len(gvs)
+    priors = next((value for key, value in cache.kept("lpv_transfer") if key[1:] == k_tr[1:]
+                   and [t.grid for t in value] == list(grids)), [None] * len(gvs))
     transfers = cache.run("lpv_transfer", k_tr, lambda: [_build(ctx, programs, gv, grid, budget, s, p)
                                                          for gv, grid, p in zip(gvs, grids, priors)])
     weights = [a * gv.surface_area[:, None] for a, gv in zip(albedo, gvs)]
     k_m = (k_tr, k_albedo)
     m_rho = cache.run("lpv_transfer_albedo", k_m, lambda: [
         transfer.albedo_transfer(t, w) for t, w in zip(transfers, weights)])
-    world = tuple(float(c) for c in scene.world.color[:3])
-    worlds = [None] * len(gvs)  # a black world: nothing to propagate (a sky it lit before stays cached)
-    if max(world) > 0:
-        k_sky = (k_gv, s.max_iterations, s.epsilon, s.clamp_negative)
-        skies = cache.run("lpv_world", k_sky, lambda: [_sky(ctx, programs, gv, grid, s)
-                                                       for gv, grid in zip(gvs, grids)])
-        worlds = [sky[..., None] * np.asarray(world) for sky in skies]
-    k_world = (k_gv, world, s.max_iterations, s.epsilon, s.clamp_negative)
-    k_src = (k_rsm, k_tr)
-    sources = cache.run("lpv_inject", k_src, lambda: [clusters.bin_flux(t.clusters, gather.rsm_records(
-        ctx, programs, maps, frame.shadows, grid, budget)[0]) for t, grid in zip(transfers, grids)])
-    k_prop = (k_src, k_m, k_world, s.bounces, s.epsilon)
-    solved = cache.run("lpv_propagate", k_prop, lambda: _solve(ctx, gvs, grids, transfers, m_rho, weights, worlds,
-                                                               sources, s))
-    k_light = (frame.keys["gbuffer"], k_prop)
-    indirect = cache.run("lpv_lighting", k_light,
-                         lambda: lighting.lighting(ctx, programs, frame.gbuffer, solved["surfaces"], gvs, s))
-    return MethodOutput(indirect, None, k_light, {"cascades": solved["stats"],
-                                                  "skipped_work": skipped_work(solved["stats"], s)})
+    return gvs, transfers, weights, m_rho, {"gv": k_gv, "transfer": k_tr, "albedo_transfer": k_m}
 
 
 def skipped_work(stats: list, s) -> list:
