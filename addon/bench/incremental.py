@@ -3,7 +3,7 @@
 
 An update is what the add-on does after an edit: extract the evaluated scene, then `Engine.render`, whose pass cache
 re-runs only the passes whose inputs changed (gpu_kernels/gl/pass_cache.py). Each kind of edit is applied to the open
-.blend with bpy (alternately +d and −d, so the scene stays put), and the median of `repeats` updates is reported.
+.blend with bpy (+d each time, then undone), and the median of `repeats` updates is reported with every run.
 Beside them: Cycles re-rendering the same scene at 1 sample + OpenImageDenoise (the peer an edit must beat), and
 what the LPV's cached transport holds in memory at a few grid resolutions. The file is never saved.
 """
@@ -88,7 +88,7 @@ def _edits(bpy):
     edits["light_move"] = mover(lights[0], 0) if lights else "the scene has no light object (emission only)"
     if lights:
         def brighten(sign):
-            lights[0].data.energy *= 1.25 if sign > 0 else 0.8
+            lights[0].data.energy *= 1.25 if sign > 0 else 0.8  # undone exactly: 1.25 × 0.8 = 1
         edits["light_power"] = brighten
     else:
         edits["light_power"] = "the scene has no light object (emission only)"
@@ -144,15 +144,15 @@ def measure_incremental(scene_resolution, method: str, repeats: int = 3) -> dict
             out[kind], detail[kind] = None, {"note": edit}
             continue
         runs = []
-        for i in range(repeats):
-            edit(1 if i % 2 == 0 else -1)
+        for _ in range(repeats):  # always onward: the cache keeps a pass's last outputs, so going back and forth
+            edit(1)               # would find the previous state cached instead of measuring an edit
             bpy.context.view_layer.update()
             runs.append(_update(engine, settings, scene_resolution))
         record(kind, runs)
-        if repeats % 2:
-            edit(-1)  # leave the scene as it was (the last +d undone), and the engine's cache in step with it,
-            bpy.context.view_layer.update()  # so the next kind measures its own edit only
-            _update(engine, settings, scene_resolution)
+        for _ in range(repeats):
+            edit(-1)  # leave the scene as it was, and the engine's cache in step with it,
+        bpy.context.view_layer.update()  # so the next kind measures its own edit only
+        _update(engine, settings, scene_resolution)
     return {**{k: out.get(k) for k in KINDS}, "detail": detail}
 
 
@@ -235,7 +235,9 @@ def format_incremental(entry: dict) -> str:
             if "note" in d:
                 lines.append(f"- {method} {k}: {d['note']}")
             elif d:
-                lines.append(f"- {method} {k}: extract {d['extract'] * 1000:.1f} ms; re-ran {', '.join(d['rerun'])}")
+                runs = ", ".join(f"{r * 1000:.0f}" for r in d.get("runs", []))
+                lines.append(f"- {method} {k}: runs {runs} ms; extract {d['extract'] * 1000:.1f} ms; "
+                             f"re-ran {', '.join(d['rerun'])}")
     memory = entry.get("lpv_transfer_memory")
     if memory:
         lines += ["", "LPV cached transport (host memory, float32; estimated from the surface area):", "",
