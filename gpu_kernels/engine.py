@@ -8,7 +8,7 @@ from concurrent.futures import Future
 from .gl.context import GpuWorker
 from .pipeline import Pipeline, RenderResult
 from .scene import Scene
-from .settings import RenderSettings, check_method, check_renderable
+from .settings import RenderSettings, check_materials, check_method, check_renderable, repair_scene
 from .surface.atlas import INDIRECT_SHARE, build_atlas
 
 _engine = None
@@ -21,7 +21,9 @@ class Engine:
         self._pipeline: Pipeline | None = None
 
     def submit_render(self, scene: Scene, settings: RenderSettings) -> Future:
-        """Queue a render on the GPU thread; the Future resolves to a RenderResult (or raises its error)."""
+        """Queue a render on the GPU thread; the Future resolves to a RenderResult (or raises its error). Broken
+        triangles and lights are left out with a warning (settings.repair_scene)."""
+        scene = repair_scene(scene)
         check_renderable(scene, settings)  # fail fast, on the caller's thread, for bad input
         return self.worker.submit(self._render, scene, settings)
 
@@ -32,6 +34,8 @@ class Engine:
         the same atlas) (pipeline.render_surface); the Future resolves to a SurfaceLight. The atlases are laid out
         on the worker thread too, so the caller (Blender's main thread) never waits for them."""
         check_method(settings)
+        scene = repair_scene(scene)
+        check_materials(scene)
         indirect_budget = max(1, budget // INDIRECT_SHARE) if indirect_budget is None else indirect_budget
         return self.worker.submit(self._render_surface, scene, settings, int(budget), int(indirect_budget))
 
@@ -39,6 +43,8 @@ class Engine:
         """Queue the light at N points with normals (pipeline.render_points, e.g. mesh vertices for a bake); the
         Future resolves to a PointLight."""
         check_method(settings)
+        scene = repair_scene(scene)
+        check_materials(scene)
         return self.worker.submit(lambda ctx: self._ensure_pipeline(ctx).render_points(
             scene, settings, positions, normals))
 

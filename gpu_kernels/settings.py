@@ -3,14 +3,20 @@
 input into one clear message (SceneError) before any GPU work starts."""
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, field
+import math
+from dataclasses import asdict, dataclass, field, replace
+
+import numpy as np
 
 from .common.lights import ShadowSettings
 from .lpv.settings import LpvSettings
-from .scene import Scene
+from .scene import Scene, finite_normals
 from .vct.settings import VctSettings
 
 METHODS = ("none", "lpv", "vct")
+# A triangle is degenerate when twice its area is below this fraction of its longest edge squared: its height is
+# under 2⁻²³ of that edge, float32's rounding of its corners.
+DEGENERATE = 2.0 ** -23
 
 
 class SceneError(ValueError):
@@ -42,3 +48,63 @@ def check_renderable(scene: Scene, settings: RenderSettings) -> None:
         raise SceneError("the scene has no camera")
     if settings.width < 1 or settings.height < 1 or settings.width > 16384 or settings.height > 16384:
         raise SceneError(f"resolution {settings.width}x{settings.height} is out of range (1..16384)")
+    if not np.isfinite(scene.camera.matrix_world).all():
+        raise SceneError("the scene camera's transform is NaN or infinite")
+    check_materials(scene)
+
+
+def check_materials(scene: Scene) -> None:
+    """Every triangle's material index names a material."""
+    index = np.asarray(scene.material_index)
+    if index.size and (index.min() < 0 or index.max() >= len(scene.materials)):
+        raise SceneError(f"material index {int(index.max() if index.max() >= len(scene.materials) else index.min())}"
+                         f" is out of range ({len(scene.materials)} materials)")
+
+
+def repair_scene(scene: Scene) -> Scene:
+    """The scene with what cannot be rendered left out, each with a warning, so one broken part never costs the user
+    the whole render: triangles with a NaN or infinite vertex, lights with a non-finite power or position;
+    degenerate triangles (no area, within float32 rounding) are left out silently; non-finite or zero shading
+    normals become the geometric normal. The scene itself when nothing needs it.
+    Extraction already leaves broken objects out by name (addon/extract/meshes.py); this covers scenes built any
+    other way. A material index out of range is a SceneError (check_renderable)."""
+    warnings, changes = [], {}
+    pos = np.asarray(scene.positions)
+    if pos.size and not np.isfinite(pos).all():
+        keep = np.isfinite(pos).all(axis=(1, 2))
+        warnings.append(f"{int((~keep).sum())} triangle(s) with a NaN or infinite vertex position left out")
+        changes = {"positions": pos[keep], "normals": np.asarray(scene.normals)[keep],
+                   "uvs": np.asarray(scene.uvs)[keep], "material_index": np.asarray(scene.material_index)[keep]}
+    pos = changes.get("positions", pos)
+    if pos.size:
+        # Degenerate triangles (collinear corners, a corner twice, one point): lines, not surfaces, within float32
+        # rounding. Left out silently (meshes often have some): they cover no pixel, but a sliver still made its
+        # voxel a surface voxel with a full normal.
+        p = pos.astype(np.float64)
+        area2 = np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
+        edge2 = np.max([((p[:, i] - p[:, (i + 1) % 3]) ** 2).sum(axis=1) for i in range(3)], axis=0)
+        keep = area2 > DEGENERATE * edge2
+        if not keep.all():
+            changes = {"positions": pos[keep], "normals": np.asarray(changes.get("normals", scene.normals))[keep],
+                       "uvs": np.asarray(changes.get("uvs", scene.uvs))[keep],
+                       "material_index": np.asarray(changes.get("material_index", scene.material_index))[keep],
+                       **{k: v for k, v in changes.items() if k == "lights"}}
+            pos = changes["positions"]
+    normals = changes.get("normals", scene.normals)
+    fixed = finite_normals(pos, np.asarray(normals))
+    if fixed is not normals:
+        changes["normals"] = fixed.astype(np.float32)
+    lights = [l for l in scene.lights if _finite_light(l)]
+    for light in scene.lights:
+        if not _finite_light(light):
+            warnings.append(f"light '{light.name}' has a NaN or infinite power, colour or transform and is left out")
+    if len(lights) != len(scene.lights):
+        changes["lights"] = lights
+    if not changes:
+        return scene
+    return replace(scene, **changes, warnings=list(scene.warnings) + warnings)
+
+
+def _finite_light(light) -> bool:
+    values = [light.power, light.radius, light.size, light.size_y, *light.color]
+    return all(math.isfinite(float(v)) for v in values) and bool(np.isfinite(light.matrix_world).all())
