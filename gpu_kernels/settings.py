@@ -4,6 +4,7 @@ input into one clear message (SceneError) before any GPU work starts."""
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
@@ -14,6 +15,13 @@ from .scene import Scene, finite_normals
 from .vct.settings import VctSettings
 
 METHODS = ("none", "lpv", "vct")
+# GPU memory a method's volumes take: bytes per voxel plus a fixed part, every texture and buffer a render allocates
+# included (tallied over renders at 16³–48³: VCT 912 B of 3D textures + ≤ 25 B of buffers per voxel of its padded
+# grid; LPV ≤ 1976 B of 3D textures (its geometry volume at twice the resolution included) + 170–320 B of buffers per
+# cell of each cascade, and ≈ 4 MB of VPL buffers at any size). tests/stress/test_grids_bounces.py holds these to a
+# tally of the allocations, so a volume added but not counted here fails a test.
+VCT_BYTES_PER_VOXEL, VCT_FIXED_BYTES = 940, 2 ** 20
+LPV_BYTES_PER_CELL, LPV_FIXED_BYTES = 2300, 8 * 2 ** 20
 # A triangle is degenerate when twice its area is below this fraction of its longest edge squared: its height is
 # under 2⁻²³ of that edge, float32's rounding of its corners.
 DEGENERATE = 2.0 ** -23
@@ -51,6 +59,47 @@ def check_renderable(scene: Scene, settings: RenderSettings) -> None:
     if not np.isfinite(scene.camera.matrix_world).all():
         raise SceneError("the scene camera's transform is NaN or infinite")
     check_materials(scene)
+    check_memory(scene, settings)
+
+
+def method_bytes(scene: Scene, settings: RenderSettings) -> int:
+    """About how many bytes of GPU memory the method's volumes take (0 for "none")."""
+    if settings.method == "vct":
+        from .vct.volumes import vct_grid
+
+        return vct_grid(scene, settings.vct).voxel_count * VCT_BYTES_PER_VOXEL + VCT_FIXED_BYTES
+    if settings.method == "lpv":
+        from .lpv.state import cascade_grids
+
+        cells = sum(g.voxel_count for g in cascade_grids(scene, settings.lpv))
+        return cells * LPV_BYTES_PER_CELL + LPV_FIXED_BYTES
+    return 0
+
+
+def available_memory() -> int | None:
+    """Bytes of memory the system can still give (Linux: MemAvailable), None where unknown. A software renderer
+    (Mesa llvmpipe) keeps its textures there, and a driver past it kills the process rather than raising."""
+    try:
+        with open("/proc/meminfo") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        pass
+    try:
+        return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (ValueError, OSError, AttributeError):
+        return None
+
+
+def check_memory(scene: Scene, settings: RenderSettings) -> None:
+    """A grid too large for the memory there is: one clear message before any allocation. (On a discrete GPU
+    with less memory than the host, the allocation fails instead: the engine reports that as GpuFailedError.)"""
+    need, have = method_bytes(scene, settings), available_memory()
+    if have is not None and need > have:
+        res = settings.vct.resolution if settings.method == "vct" else settings.lpv.resolution
+        raise SceneError(f"the {settings.method.upper()} grid (resolution {res}) needs about {need / 2 ** 30:.1f} GiB "
+                         f"of memory, more than the {have / 2 ** 30:.1f} GiB available; lower its resolution")
 
 
 def check_materials(scene: Scene) -> None:
