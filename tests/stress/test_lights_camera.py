@@ -116,18 +116,20 @@ LEAK_INSIDE = {"none": 0.0, "lpv": 0.5, "vct": 0.5}
 
 
 @pytest.mark.parametrize("method", ALL)
-@pytest.mark.parametrize("where", ("on the floor", "on a wall corner", "outside the room"))
+@pytest.mark.parametrize("where", ("on the floor", "on a wall corner", "outside the room", "just behind a wall"))
 def test_lights_on_and_beyond_surfaces(engine, method, where):
-    at = {"on the floor": (0.6, -0.6, 0.0), "on a wall corner": (1.0, 1.0, 2.0), "outside the room": (3, 0, 1)}
+    at = {"on the floor": (0.6, -0.6, 0.0), "on a wall corner": (1.0, 1.0, 2.0), "outside the room": (3, 0, 1),
+          "just behind a wall": (1.5, 0.2, 1.2)}
     result = render(engine, box_room(lights=[light("POINT", 100.0, at[where])]), method)
-    if where == "outside the room":
+    if where in ("outside the room", "just behind a wall"):
         assert lit_fraction(result) <= SHADOW_LEAK  # the closed room stays dark
 
 
-# Pixels that shadow maps let direct light reach through a closed surface, as a fraction of the image: measured 3
-# of 768 (a light inside the block: rays grazing its corner edge, which lies on a seam of the shadow cube) and 3 of
-# 768 (a light outside the room, pixels where two walls meet); bound 1%. The stress suite's docs list it.
-SHADOW_LEAK = 0.01
+# Pixels that direct light reaches through a closed surface, as a fraction of the 768: a light inside the block 1
+# (a pixel on the block's silhouette that hits the inside of its top face: truly lit), a light behind a wall 2–3
+# (within 5 mm of the corner where two walls meet). Bound 4 pixels. Before the cube face was chosen for the biased
+# point (direct/eval.glsl) a light just behind a wall lit 6, and one inside the block 3.
+SHADOW_LEAK = 4 / 768
 
 
 def lit_fraction(result) -> float:
