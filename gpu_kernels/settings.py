@@ -25,6 +25,7 @@ LPV_BYTES_PER_CELL, LPV_FIXED_BYTES = 2300, 8 * 2 ** 20
 # A triangle is degenerate when twice its area is below this fraction of its longest edge squared: its height is
 # under 2⁻²³ of that edge, float32's rounding of its corners.
 DEGENERATE = 2.0 ** -23
+TRIANGLE_ARRAYS = ("positions", "normals", "uvs", "material_index")
 
 
 class SceneError(ValueError):
@@ -117,41 +118,35 @@ def repair_scene(scene: Scene) -> Scene:
     normals become the geometric normal. The scene itself when nothing needs it.
     Extraction already leaves broken objects out by name (addon/extract/meshes.py); this covers scenes built any
     other way. A material index out of range is a SceneError (check_renderable)."""
-    warnings, changes = [], {}
-    pos = np.asarray(scene.positions)
-    if pos.size and not np.isfinite(pos).all():
-        keep = np.isfinite(pos).all(axis=(1, 2))
-        warnings.append(f"{int((~keep).sum())} triangle(s) with a NaN or infinite vertex position left out")
-        changes = {"positions": pos[keep], "normals": np.asarray(scene.normals)[keep],
-                   "uvs": np.asarray(scene.uvs)[keep], "material_index": np.asarray(scene.material_index)[keep]}
-    pos = changes.get("positions", pos)
-    if pos.size:
-        # Degenerate triangles (collinear corners, a corner twice, one point): lines, not surfaces, within float32
-        # rounding. Left out silently (meshes often have some): they cover no pixel, but a sliver still made its
-        # voxel a surface voxel with a full normal.
-        p = pos.astype(np.float64)
-        area2 = np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
-        edge2 = np.max([((p[:, i] - p[:, (i + 1) % 3]) ** 2).sum(axis=1) for i in range(3)], axis=0)
-        keep = area2 > DEGENERATE * edge2
-        if not keep.all():
-            changes = {"positions": pos[keep], "normals": np.asarray(changes.get("normals", scene.normals))[keep],
-                       "uvs": np.asarray(changes.get("uvs", scene.uvs))[keep],
-                       "material_index": np.asarray(changes.get("material_index", scene.material_index))[keep],
-                       **{k: v for k, v in changes.items() if k == "lights"}}
-            pos = changes["positions"]
-    normals = changes.get("normals", scene.normals)
-    fixed = finite_normals(pos, np.asarray(normals))
-    if fixed is not normals:
-        changes["normals"] = fixed.astype(np.float32)
-    lights = [l for l in scene.lights if _finite_light(l)]
-    for light in scene.lights:
-        if not _finite_light(light):
-            warnings.append(f"light '{light.name}' has a NaN or infinite power, colour or transform and is left out")
-    if len(lights) != len(scene.lights):
-        changes["lights"] = lights
-    if not changes:
+    arrays = {name: np.asarray(getattr(scene, name)) for name in TRIANGLE_ARRAYS}
+    finite = np.isfinite(arrays["positions"]).all(axis=(1, 2))
+    warnings = [] if finite.all() else [f"{int((~finite).sum())} triangle(s) with a NaN or infinite vertex position "
+                                        "left out"]
+    keep = finite & ~_degenerate(arrays["positions"])
+    changed = not keep.all()
+    if changed:
+        arrays = {name: a[keep] for name, a in arrays.items()}
+    normals = finite_normals(arrays["positions"], arrays["normals"])
+    if normals is not arrays["normals"]:
+        arrays["normals"], changed = normals.astype(np.float32), True
+    lights = [light for light in scene.lights if _finite_light(light)]
+    warnings += [f"light '{light.name}' has a NaN or infinite power, colour or transform and is left out"
+                 for light in scene.lights if not _finite_light(light)]
+    if not changed and len(lights) == len(scene.lights):
         return scene
-    return replace(scene, **changes, warnings=list(scene.warnings) + warnings)
+    return replace(scene, **arrays, lights=lights, warnings=list(scene.warnings) + warnings)
+
+
+def _degenerate(positions: np.ndarray) -> np.ndarray:
+    """Triangles that are lines, not surfaces, within float32 rounding (collinear corners, a corner twice, one
+    point): left out silently, as meshes often have some. They cover no pixel, but a sliver still made its voxel a
+    surface voxel with a full normal."""
+    p = positions.astype(np.float64)
+    with np.errstate(invalid="ignore", over="ignore"):
+        area2 = np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
+        edge2 = np.max([((p[:, i] - p[:, (i + 1) % 3]) ** 2).sum(axis=1) for i in range(3)], axis=0) \
+            if len(p) else np.zeros(0)
+        return ~(area2 > DEGENERATE * edge2)
 
 
 def _finite_light(light) -> bool:
