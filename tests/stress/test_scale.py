@@ -33,10 +33,10 @@ def reference(engine, method, kind="POINT"):
 
 
 # Tolerances on rel-L1 of Combined against the unscaled room (measured at 32 × 24, LPV 8³, VCT 16³):
-BINARY_TOL = 1e-4  # float32 rounding only: measured ≤ 3e-5 for every method
-DECIMAL_TOL = {"none": 1e-4,  # direct light has no lattice: measured ≤ 6e-7
-               "lpv": 0.01,   # the 1%; measured ≤ 0.6% (lattice moved by ≤ 2⁻¹⁶ cell)
-               "vct": 0.01}   # measured ≤ 0.45%
+BINARY_TOL = 1e-4  # measured 0.0 (bit-identical) for every method here; 1e-4 for a driver that rounds otherwise
+DECIMAL_TOL = {"none": 1e-5,   # direct light has no lattice: measured ≤ 7e-7
+               "lpv": 0.01,    # the 1%; measured ≤ 0.36% (the gathered transport's clustering)
+               "vct": 0.003}   # measured ≤ 0.066%: 4× margin, well inside the 1%
 
 
 @pytest.mark.parametrize("method", ("none",) + METHODS)
