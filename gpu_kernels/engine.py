@@ -5,10 +5,11 @@ from __future__ import annotations
 import threading
 from concurrent.futures import Future
 
-from .gl.context import GpuWorker
+from .gl.context import GpuFailedError, GpuWorker
+from .gl.preprocessor import ShaderCompileError
 from .pipeline import Pipeline, RenderResult
 from .scene import Scene
-from .settings import RenderSettings, check_method, check_renderable
+from .settings import RenderSettings, check_materials, check_method, check_renderable, repair_scene
 from .surface.atlas import INDIRECT_SHARE, build_atlas
 
 _engine = None
@@ -21,9 +22,11 @@ class Engine:
         self._pipeline: Pipeline | None = None
 
     def submit_render(self, scene: Scene, settings: RenderSettings) -> Future:
-        """Queue a render on the GPU thread; the Future resolves to a RenderResult (or raises its error)."""
+        """Queue a render on the GPU thread; the Future resolves to a RenderResult (or raises its error). Broken
+        triangles and lights are left out with a warning (settings.repair_scene)."""
+        scene = repair_scene(scene)
         check_renderable(scene, settings)  # fail fast, on the caller's thread, for bad input
-        return self.worker.submit(self._render, scene, settings)
+        return self.worker.submit(self._guarded, self._render, scene, settings)
 
     def submit_surface(self, scene: Scene, settings: RenderSettings, budget: int,
                        indirect_budget: int | None = None) -> Future:
@@ -32,15 +35,45 @@ class Engine:
         the same atlas) (pipeline.render_surface); the Future resolves to a SurfaceLight. The atlases are laid out
         on the worker thread too, so the caller (Blender's main thread) never waits for them."""
         check_method(settings)
+        scene = repair_scene(scene)
+        check_materials(scene)
         indirect_budget = max(1, budget // INDIRECT_SHARE) if indirect_budget is None else indirect_budget
-        return self.worker.submit(self._render_surface, scene, settings, int(budget), int(indirect_budget))
+        return self.worker.submit(self._guarded, self._render_surface, scene, settings, int(budget),
+                                  int(indirect_budget))
 
     def submit_points(self, scene: Scene, settings: RenderSettings, positions, normals) -> Future:
         """Queue the light at N points with normals (pipeline.render_points, e.g. mesh vertices for a bake); the
         Future resolves to a PointLight."""
         check_method(settings)
-        return self.worker.submit(lambda ctx: self._ensure_pipeline(ctx).render_points(
+        scene = repair_scene(scene)
+        check_materials(scene)
+        return self.worker.submit(self._guarded, lambda ctx: self._ensure_pipeline(ctx).render_points(
             scene, settings, positions, normals))
+
+    def _guarded(self, ctx, job, *args):
+        """`job(ctx, *args)`, with a failure of the GPU turned into one GpuFailedError line: a shader the driver
+        rejects, or a GL error or memory exhaustion mid-render (out of memory, a lost context). After the latter
+        the pipeline and the context are dropped, so the next render starts on a fresh context with nothing
+        half-made in its caches."""
+        import moderngl
+
+        try:
+            return job(ctx, *args)
+        except ShaderCompileError as exc:
+            raise GpuFailedError(f"the GPU driver could not compile a shader: {_first_line(exc)}") from exc
+        except (moderngl.Error, MemoryError) as exc:
+            self._drop_pipeline()
+            self.worker.drop_context()
+            raise GpuFailedError(f"the GPU failed during the render ({type(exc).__name__}: {_first_line(exc)}); "
+                                 "lower the resolution or grid size if it ran out of memory") from exc
+
+    def _drop_pipeline(self) -> None:
+        pipeline, self._pipeline = self._pipeline, None
+        if pipeline is not None:
+            try:
+                pipeline.release()
+            except Exception:  # the objects of a failed context may not release; they go with the context
+                pass
 
     def _ensure_pipeline(self, ctx) -> Pipeline:
         """The pipeline, made on the worker thread by its first job."""
@@ -81,6 +114,11 @@ class Engine:
 
     def gl_info(self) -> dict:
         return self.worker.call(lambda ctx: {"renderer": ctx.info["GL_RENDERER"], "version": ctx.version_code})
+
+
+def _first_line(exc: BaseException) -> str:
+    text = str(exc).strip()
+    return text.splitlines()[0] if text else type(exc).__name__
 
 
 def get_engine() -> Engine:

@@ -140,6 +140,22 @@ class Scene:
         return h.hexdigest()[:20]
 
 
+def finite_normals(positions: np.ndarray, normals: np.ndarray) -> np.ndarray:
+    """`normals` with every non-finite or zero corner normal replaced by its triangle's geometric normal (a mesh
+    with broken custom normals still shades; the winding says which side is the front), and by +Z where the
+    triangle has no area either (a zero-area triangle covers nothing, but its normal still enters sums)."""
+    bad = ~np.isfinite(normals).all(axis=-1) | (np.abs(normals).sum(axis=-1) == 0)
+    if not bad.any():
+        return normals
+    p = positions.astype(np.float64)
+    geo = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    length = np.linalg.norm(geo, axis=-1, keepdims=True)
+    geo = np.where(length > 0, geo / np.maximum(length, 1e-300), (0.0, 0.0, 1.0))
+    out = normals.copy()
+    out[bad] = np.broadcast_to(geo[:, None, :], normals.shape)[bad]
+    return out
+
+
 def hash_parts(*parts) -> str:
     """A SHA-1 of `parts` (arrays, dataclasses, lists, numbers, strings): the content keys of the pass cache."""
     h = hashlib.sha1()

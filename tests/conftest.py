@@ -10,8 +10,14 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 # The folder a test lives in is its marker: unit (pure Python), gpu (moderngl on llvmpipe), blender (bpy in a
-# subprocess), accuracy (against Cycles renders). `make test-fast` runs `-m "unit or gpu"`.
-MARKERS = ("unit", "gpu", "blender", "accuracy")
+# subprocess), accuracy (against Cycles renders), stress (numerical stability and bad input, docs/stress.md).
+# `make test-fast` runs `-m "unit or gpu"`.
+MARKERS = ("unit", "gpu", "blender", "accuracy", "stress")
+
+
+def pytest_addoption(parser):
+    parser.addoption("--stress-full", action="store_true", default=False,
+                     help="tests/stress: the longer cases too (larger grids, more bounces, more random scenes)")
 
 
 def pytest_collection_modifyitems(items):

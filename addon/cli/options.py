@@ -60,14 +60,21 @@ def settings_of(scene, method: str, lpv_options: dict | None, vct_settings: dict
 
 def render_ours(scene, method: str, lpv_options: dict | None = None, vct_settings: dict | None = None):
     from ...gpu_kernels.engine import get_engine
+
+    settings = settings_of(scene, method, lpv_options, vct_settings)
+    return engine_result(lambda: get_engine().render(scene, settings))
+
+
+def engine_result(call):
+    """`call()`, with the engine's errors meant for the user (bad input, no OpenGL 4.3, the GPU failing, a grid
+    too large) as one-line CliErrors."""
     from ...gpu_kernels.gl.context import GpuUnavailableError
     from ...gpu_kernels.settings import SceneError
 
-    settings = settings_of(scene, method, lpv_options, vct_settings)
     try:
-        return get_engine().render(scene, settings)
+        return call()
     except (SceneError, NotImplementedError, GpuUnavailableError) as exc:
-        raise CliError(str(exc)) from None
+        raise CliError(" ".join(str(exc).split())) from None
 
 
 def auto_quality(args) -> dict | None:

@@ -4,7 +4,7 @@ scene-linear) or a PNG (Standard view transform) — the viewport's drawing path
 from __future__ import annotations
 
 from ..scene_io import CliError, check_output_path, load_scene, write_output
-from .options import method_settings
+from .options import engine_result, method_settings
 
 SUFFIXES = (".exr", ".png")
 
@@ -19,7 +19,7 @@ def cmd_snapshot(args) -> dict:
     from ...gpu_kernels.engine import get_engine
     from ...ui import draw
 
-    light = get_engine().submit_surface(scene, settings, args.texels).result()
+    light = engine_result(lambda: get_engine().submit_surface(scene, settings, args.texels).result())
     width, height = (int(v) for v in scene.resolution)
     image = draw.snapshot(light, scene, width, height, args.display.upper())
     if suffix == ".exr":

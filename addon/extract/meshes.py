@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ...gpu_kernels.scene import finite_normals
+
 GEOMETRY_TYPES = {"MESH", "CURVE", "SURFACE", "FONT", "META", "CURVES"}
 ARRAYS = {"positions": ((0, 3, 3), np.float32), "normals": ((0, 3, 3), np.float32), "uvs": ((0, 3, 2), np.float32),
           "material_index": ((0,), np.int32)}  # name -> (shape when empty, dtype) of the Scene's triangle arrays
@@ -73,20 +75,6 @@ def object_arrays(obj, material_index) -> dict | None:
     if obj.type != "MESH":
         obj.to_mesh_clear()
     return arrays
-
-
-def finite_normals(positions: np.ndarray, normals: np.ndarray) -> np.ndarray:
-    """`normals` with every non-finite or zero corner normal replaced by its triangle's geometric normal (a mesh
-    with broken custom normals still shades; the winding says which side is the front)."""
-    bad = ~np.isfinite(normals).all(axis=-1) | (np.abs(normals).sum(axis=-1) == 0)
-    if not bad.any():
-        return normals
-    p = positions.astype(np.float64)
-    geo = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
-    geo /= np.maximum(np.linalg.norm(geo, axis=-1, keepdims=True), 1e-30)
-    out = normals.copy()
-    out[bad] = np.broadcast_to(geo[:, None, :], normals.shape)[bad]
-    return out
 
 
 class Geometry:

@@ -133,7 +133,13 @@ def triangle_sample_points(tri: np.ndarray, count: int) -> np.ndarray:
 
 def _scene_radius(scene: Scene) -> tuple[np.ndarray, float]:
     lo, hi = scene.bounds()
-    return (lo + hi) / 2, max(float(np.linalg.norm(hi - lo)) / 2, 1e-3)
+    centre = (lo + hi) / 2
+    # A floor relative to where the scene is (a point-sized scene still gets a non-empty view), never in metres:
+    # a scene scaled by s must get views scaled by s.
+    # (1e-12 m, nine orders below the smallest scale the stress suite renders, only for a scene that is one point at
+    # the origin.)
+    floor = max(1e-6 * float(np.abs(centre).max()), 1e-12)
+    return centre, max(float(np.linalg.norm(hi - lo)) / 2, floor)
 
 
 def cube_views(origin, resolution: int, near: float, far: float) -> list[ShadowView]:
@@ -174,7 +180,7 @@ def spot_view(scene: Scene, light: Light, resolution: int, near: float, far: flo
 def _near_far(scene: Scene, origin) -> tuple[float, float]:
     centre, radius = _scene_radius(scene)
     far = float(np.linalg.norm(np.asarray(origin) - centre)) + radius * 1.01
-    return max(far * 1e-4, 1e-3), max(far, 1e-2)
+    return far * 1e-4, far  # relative only: a metre-valued floor here clipped millimetre scenes' shadow maps
 
 
 def emissive_triangles(scene: Scene) -> tuple[np.ndarray, np.ndarray]:

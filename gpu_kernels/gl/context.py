@@ -20,6 +20,11 @@ class GpuUnavailableError(RuntimeError):
     """No OpenGL 4.3 context could be made; the message says why in one line."""
 
 
+class GpuFailedError(GpuUnavailableError):
+    """The GPU failed during a render: out of memory, a lost context, a shader the driver will not compile. One line
+    for the user; the engine drops what it held on that context, so the next render starts afresh."""
+
+
 def create_context():
     """Create a standalone OpenGL ≥ 4.3 context: EGL first (headless, works with Mesa llvmpipe), then the default."""
     import moderngl
@@ -44,14 +49,14 @@ class GpuWorker:
     """A daemon thread that owns the GL context and runs submitted jobs in order.
 
     `submit(fn, *args)` runs `fn(ctx, *args)` on the worker and returns a Future. The context is created lazily by
-    the first job, so constructing a worker costs nothing and a missing GPU shows up as that job's exception.
+    the first job, so constructing a worker costs nothing and a missing GPU shows up as that job's exception; a job
+    after a failed creation tries again (the driver may have been fixed meanwhile).
     """
 
     def __init__(self, context_factory=create_context):
         self._factory = context_factory
         self._jobs: queue.Queue = queue.Queue()
         self._ctx = None
-        self._ctx_error: BaseException | None = None
         self._closed = False
         self._submit_lock = threading.Lock()  # a job is never queued behind the shutdown sentinel
         self._thread = threading.Thread(target=self._loop, name="bounce-gi-gpu", daemon=True)
@@ -83,16 +88,21 @@ class GpuWorker:
             if not future.set_running_or_notify_cancel():
                 continue
             try:
-                if self._ctx is None and self._ctx_error is None:
-                    try:
-                        self._ctx = self._factory()
-                    except BaseException as exc:  # remember: every later job gets the same clear error
-                        self._ctx_error = exc
-                if self._ctx_error is not None:
-                    raise self._ctx_error
+                if self._ctx is None:  # first job, or the first after drop_context: (re)try, so a cause gone is gone
+                    self._ctx = self._factory()
                 future.set_result(fn(self._ctx, *args, **kwargs))
             except BaseException as exc:
                 future.set_exception(exc)
+
+    def drop_context(self) -> None:
+        """Release the context (on the worker thread, from inside a job) after the GPU failed; the next job makes a
+        new one. The caller has released or forgotten every GL object made with it."""
+        ctx, self._ctx = self._ctx, None
+        if ctx is not None:
+            try:
+                ctx.release()
+            except Exception:  # a lost context may fail to release too; it is gone either way
+                pass
 
     def _close_context(self, done: Future, cleanup) -> None:
         """On the worker thread, last: `cleanup(ctx)` and the context's release, if a context was ever made."""

@@ -18,7 +18,8 @@ FIXED_RANGE = 2.0 ** 29  # fixed-point headroom: a cell's coefficient sum stays 
 
 def cascade_grids(scene: Scene, settings: LpvSettings) -> list[Grid]:
     """The coarsest cascade covers the scene; each finer one has half the cell size, centred on the camera
-    (clamped into the scene) and snapped to whole cells so small camera moves don't shift the lattice."""
+    (clamped into the scene) and snapped to whole cells of the coarse grid's lattice so small camera moves don't shift
+    it and every cascade's cells nest in the next one's."""
     lo, hi = scene.bounds()
     coarse = Grid.fit(lo, hi, settings.resolution, margin_cells=1)
     if settings.cascades <= 1:
@@ -29,7 +30,7 @@ def cascade_grids(scene: Scene, settings: LpvSettings) -> list[Grid]:
     n = settings.resolution
     for level in range(1, settings.cascades):
         cell = coarse.cell / 2 ** level
-        grids.append(Grid.centered(centre, cell, (n, n, n)))
+        grids.append(Grid.centered(centre, cell, (n, n, n), anchor=coarse.origin))
     return grids[::-1]  # finest first
 
 

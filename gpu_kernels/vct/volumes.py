@@ -21,7 +21,7 @@ def mip_levels(resolution: int) -> int:
 
 
 def vct_grid(scene: Scene, settings: VctSettings) -> Grid:
-    """Grid.fit over the scene (1 empty margin voxel, origin snapped to whole cells, Freed 2018, §4.1), each axis
+    """Grid.fit over the scene (1 empty margin voxel, origin snapped to the lattice, Freed 2018, §4.1), each axis
     padded up to a multiple of 2^(levels − 1) so every parent voxel has exactly 8 children at every level and
     the levels' texel centres nest (no half texels at borders)."""
     lo, hi = scene.bounds()

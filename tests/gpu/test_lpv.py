@@ -117,7 +117,8 @@ def test_closed_sphere_one_bounce_against_the_analytic_irradiance(engine, transp
     spread there is comes from the VPL clusters and the voxels' centres). The propagating transport does not:
     64 iterations 0.71·E₁, spread 0.43–0.82 (256 iterations: 0.81·E₁) — light still in flight when iterations stop
     and light leaking through the fuzzy walls (17% absorbed on the outside at 256 iterations); it is held to
-    today's level (0.65–1.15, ±50% of the mean) as a regression bound.
+    today's level (0.65–1.15; spread within 0.45–1.5 of the mean: 0.49–1.57 measured since the lattice's boundaries
+    moved to (k + 1/3) cells, common/grid.LATTICE_PHASE, 0.53–1.47 before) as a regression bound.
     """
     scene = _sphere_scene(subdivisions=4)
     r = engine.render(scene, RenderSettings("lpv", 96, 72, lpv=LpvSettings(resolution=32, bounces=1,
@@ -132,7 +133,7 @@ def test_closed_sphere_one_bounce_against_the_analytic_irradiance(engine, transp
         assert irradiance.min() > 0.9 * irradiance.mean() and irradiance.max() < 1.1 * irradiance.mean()
     else:
         assert 0.65 <= ratio <= 1.15
-        assert irradiance.min() > 0.5 * irradiance.mean() and irradiance.max() < 1.5 * irradiance.mean()
+        assert irradiance.min() > 0.45 * irradiance.mean() and irradiance.max() < 1.6 * irradiance.mean()
 
 
 def test_cascades_agree_with_a_single_grid_where_they_overlap(engine):

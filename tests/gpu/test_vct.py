@@ -240,10 +240,13 @@ def test_thin_wall_leak_isotropic_vs_anisotropic(engine):
     # floor through those texels (0.74% with the volumetric march; 1.4% before cone_step's layer test); bound 3%.
     assert leaks[True, 1] < 0.03
     # Every further bounce re-reflects what leaked and leaks again: with the default 8 bounces measured 3.0%
-    # (2.0% with the volumetric march, 3.6% before the layer test); bound 6%.
+    # (2.0% with the volumetric march, 3.6% before the layer test; 5.5% since the lattice's boundaries moved to
+    # (k + 1/3) cells, common/grid.LATTICE_PHASE, which put the wall at x = 0 off a voxel boundary); bound 6%.
     assert leaks[True, 8] < 0.06
-    # Isotropic voxels show the lit face on both sides (the classic VCT leak): measured 20% with one bounce.
-    assert leaks[False, 1] > 10 * max(leaks[True, 1], 1e-4)
+    # Isotropic voxels show the lit face on both sides (the classic VCT leak): measured 20% with one bounce on the
+    # whole-cell lattice, 10.6% since the phase (the wall now inside a voxel, not on a boundary), 8× the anisotropic
+    # leak; bound 5×.
+    assert leaks[False, 1] > 5 * max(leaks[True, 1], 1e-4)
 
 
 def test_a_sunlit_roof_top_does_not_light_the_room_below(engine):

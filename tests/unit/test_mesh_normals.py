@@ -1,9 +1,9 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""addon/extract/meshes.finite_normals: broken corner normals (NaN, infinite, zero) fall back to the triangle's
-geometric normal; good ones are kept as they are."""
+"""gpu_kernels/scene.finite_normals (extraction and the engine repair meshes with it): broken corner normals (NaN,
+infinite, zero) fall back to the triangle's geometric normal; good ones are kept as they are."""
 import numpy as np
 
-from bounce_gi.addon.extract.meshes import finite_normals
+from bounce_gi.gpu_kernels.scene import finite_normals
 
 
 def test_broken_corner_normals_become_the_geometric_normal():

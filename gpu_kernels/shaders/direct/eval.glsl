@@ -11,15 +11,20 @@ uniform vec2 u_atlas_texel;        // 1 / atlas size
 
 // Visibility of world point p from one shadow view with a normal-offset bias and percentage-closer filtering.
 // The offset grows with the shadow texel's world footprint, which removes acne without a hand-tuned constant.
-float view_visibility(int view_index, vec3 p, vec3 geo_n, vec3 to_light) {
-    ShadowView v = shadow_views[view_index];
+vec3 biased_point(ShadowView v, vec3 p, vec3 geo_n, vec3 to_light) {
     bool ortho = v.origin.w > 0.5;
     float dist = ortho ? 1.0 : length(p - v.origin.xyz);
     float texel_world = v.info.x * dist;
     float cos_l = clamp(dot(geo_n, to_light), 0.0, 1.0);
     float sin_l = sqrt(max(0.0, 1.0 - cos_l * cos_l));
     // 1.5 texels along the normal, more at grazing angles (slope-scaled), capped.
-    vec3 q = p + geo_n * texel_world * (1.5 + 2.0 * min(sin_l / max(cos_l, 0.05), 8.0));
+    return p + geo_n * texel_world * (1.5 + 2.0 * min(sin_l / max(cos_l, 0.05), 8.0));
+}
+
+float view_visibility(int view_index, vec3 p, vec3 geo_n, vec3 to_light) {
+    ShadowView v = shadow_views[view_index];
+    bool ortho = v.origin.w > 0.5;
+    vec3 q = biased_point(v, p, geo_n, to_light);
     vec4 clip = v.view_projection * vec4(q, 1.0);
     vec3 ndc = clip.xyz / clip.w;
     if (clip.w <= 0.0) return 1.0;
@@ -41,10 +46,15 @@ float view_visibility(int view_index, vec3 p, vec3 geo_n, vec3 to_light) {
     return sum / float((2 * r + 1) * (2 * r + 1));
 }
 
+// The face is chosen for the biased point, the one the test projects: chosen for p, a point near a face's edge
+// could be pushed out of that face's frustum (past its two-texel margin) and read as unshadowed — light came through
+// closed walls where rays ran close to a cube seam (tests/stress/test_lights_camera.py). All six faces share the
+// view's texel size, so the bias is the same whichever face is asked.
 float cube_visibility(int first_view, vec3 p, vec3 geo_n) {
     vec3 origin = shadow_views[first_view].origin.xyz;
     vec3 to_light = normalize(origin - p);
-    return view_visibility(first_view + cube_face(p - origin), p, geo_n, to_light);
+    vec3 q = biased_point(shadow_views[first_view], p, geo_n, to_light);
+    return view_visibility(first_view + cube_face(q - origin), p, geo_n, to_light);
 }
 
 // Weighted visibility of a polygon light from its shadow sample points: each sample is weighted by its own

@@ -124,5 +124,8 @@ void main() {
 #endif
         remaining -= w;
     }
-    imageStore(u_diffuse_indirect, px, vec4(irradiance / PI, 1.0));
+    // Irradiance is never negative. The propagating transport's SH lobes are (clamp_negative off), so a face can
+    // absorb negative flux where light has not yet arrived from the side it lobes towards: one propagation step
+    // gave Combined −0.025 (tests/stress). The intensity lookup clamps the same way (sample_cascade).
+    imageStore(u_diffuse_indirect, px, vec4(max(irradiance, vec3(0.0)) / PI, 1.0));
 }

@@ -1,0 +1,38 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""The furnace: a closed box whose walls all emit Le and reflect ρ, no lights. Diffuse Direct = Le (the walls all
+round give irradiance π·Le), and with N bounces Diffuse Indirect = Le·(ρ + ρ² + … + ρ^N) → Le·ρ/(1 − ρ): albedo 0
+gives no indirect light at all, albedo 1 gives N·Le — finite for every finite N."""
+import pytest
+
+from support.stress import METHODS, check_sane, furnace, settings
+
+LE = 1.0
+# Mean Diffuse Indirect / the series, measured at LPV 8³ and VCT 16³ (5 cones, 1 sub-ray): VCT 0.997 (N = 1) down
+# to 0.913 (ρ = 1, N = 8) — texels half outside the box let cones out (tests/gpu/test_vct.py); LPV 0.944 at N = 1,
+# then it loses light with every bounce: 0.88 (ρ = 0.5, N = 4) down to 0.68 (ρ = 1, N = 8) — a finding of this
+# suite (docs/stress.md). Bounds: the measured range widened by 0.03–0.05 for noise, so a further loss fails.
+BOUNDS = {"lpv": (0.63, 1.03), "vct": (0.88, 1.03)}
+
+
+@pytest.mark.parametrize("method", METHODS)
+@pytest.mark.parametrize("albedo", (0.0, 0.5, 0.9, 1.0))
+@pytest.mark.parametrize("bounces", (1, 2, 4, 8))
+def test_furnace_matches_the_series(engine, method, albedo, bounces):
+    scene = furnace(albedo, LE)
+    s = settings(method, bounces=bounces)
+    result = engine.render(scene, s)
+    check_sane(result, scene, s)
+    hit = result.passes["Depth"][..., 0] < 1e9
+    direct = float(result.passes["Diffuse Direct"][..., :3][hit].mean())
+    indirect = float(result.passes["Diffuse Indirect"][..., :3][hit].mean())
+    series = LE * sum(albedo ** i for i in range(1, bounces + 1))
+    print(f"furnace {method} ρ={albedo} N={bounces}: direct {direct:.4f}, indirect {indirect:.4f}, "
+          f"series {series:.4f}, ratio {indirect / series if series else float('nan'):.4f}")
+    if albedo == 0.0:  # a black surface shows no diffuse light (Cycles' passes divide the albedo out)
+        assert direct == 0.0 and indirect == 0.0
+        assert float(result.passes["Emission"][..., :3][hit].mean()) == pytest.approx(LE, rel=1e-6)
+        return
+    # Direct light is the exact polygon integral through shadow cubes: measured 0.996; 1%.
+    assert direct == pytest.approx(LE, rel=0.01)
+    lo, hi = BOUNDS[method]
+    assert lo * series <= indirect <= hi * series
