@@ -72,8 +72,10 @@ def method_bytes(scene: Scene, settings: RenderSettings) -> int:
     if settings.method == "lpv":
         from .lpv.state import cascade_grids
 
+        from .lpv.passes import transfer_bytes
+
         cells = sum(g.voxel_count for g in cascade_grids(scene, settings.lpv))
-        return cells * LPV_BYTES_PER_CELL + LPV_FIXED_BYTES
+        return cells * LPV_BYTES_PER_CELL + LPV_FIXED_BYTES + transfer_bytes(scene, settings.lpv)[0]
     return 0
 
 
@@ -97,6 +99,10 @@ def check_memory(scene: Scene, settings: RenderSettings) -> None:
     """A grid too large for the memory there is: one clear message before any allocation. (On a discrete GPU
     with less memory than the host, the allocation fails instead: the engine reports that as GpuFailedError.)"""
     need, have = method_bytes(scene, settings), available_memory()
+    if settings.method == "lpv":  # the LPV's cached transfer lives in host memory
+        from .lpv.passes import transfer_bytes
+
+        need += transfer_bytes(scene, settings.lpv)[1]
     if have is not None and need > have:
         res = settings.vct.resolution if settings.method == "vct" else settings.lpv.resolution
         raise SceneError(f"the {settings.method.upper()} grid (resolution {res}) needs about {need / 2 ** 30:.1f} GiB "

@@ -103,6 +103,21 @@ def transfer_estimate(scene, s) -> dict:
             "mb": 8 * budget * voxels / 2 ** 20, "transport": "transfer" if budget else "gather"}
 
 
+def transfer_bytes(scene, s) -> tuple[int, int]:
+    """(GPU, host) bytes the cached transport adds at these settings, estimated from the surface area: the GPU's
+    read-back buffer of T's rows (transfer.ROWS_BYTES), the sources and the two irradiance textures per cascade;
+    T itself in host memory (2 × clusters × surface voxels float32)."""
+    grids = cascade_grids(scene, s)
+    budget = transfer_budget(scene, grids, s)
+    if not budget:
+        return 0, 0
+    voxels = surface_voxels(scene, grids)
+    fine = sum(int(np.prod([2 * n + 2 for n in g.size])) for g in grids)
+    rows = min(transfer.ROWS_BYTES, 8 * budget * voxels)
+    gpu = len(grids) * int(rows + budget * gather.VPL_DTYPE.itemsize) + 2 * fine * 16
+    return gpu, len(grids) * int(8 * budget * voxels)
+
+
 def _transfer(frame, grids, k_grids, maps, k_rsm, budget) -> MethodOutput:
     """The cached transport's passes (lpv/transfer.py); see the module docstring for what each reads."""
     ctx, programs, cache, scene, s = frame.ctx, frame.programs, frame.cache, frame.scene, frame.settings.lpv

@@ -34,12 +34,13 @@ from .clusters import Clusters
 from .gather import vpls_per_dispatch
 
 MIN_CLUSTERS = 64  # fewer sources than this blur a room's bounce into a few blobs: gather instead
+ROWS_BYTES = 8 << 20  # GPU buffer T is read back through, a dispatch at a time
 
 
 def build_transfer(ctx, programs, gv, grid: Grid, clusters: Clusters, occlusion: bool, update=None) -> np.ndarray:
     """T: (2, C, R) float32 — what cluster c of unit flux gives receiver r's front (0) and back (1) side, the kernel
     of lpv/gather.glsl evaluated on the GPU (MODE_TRANSFER), in dispatches of at most vpls_per_dispatch sources
-    and 64 MiB. With `update` = (fresh receivers (R,) bool, fresh clusters (C,) bool, box (2, 3)), only pairs with
+    and ROWS_BYTES. With `update` = (fresh receivers (R,) bool, fresh clusters (C,) bool, box (2, 3)), only pairs with
     a fresh end or a ray through the box are evaluated; the rest come back NaN (update_transfer fills them)."""
     r, c = int(gv.surface_count), clusters.count
     out = np.zeros((2, c, r), np.float32)
@@ -65,7 +66,7 @@ def build_transfer(ctx, programs, gv, grid: Grid, clusters: Clusters, occlusion:
     sources = ctx.buffer(records.tobytes())
     sources.bind_to_storage_buffer(6)
     (receivers or gv.surfaces).bind_to_storage_buffer(7)
-    chunk = max(1, min(vpls_per_dispatch(grid), (64 << 20) // (8 * r)))
+    chunk = max(1, min(vpls_per_dispatch(grid), ROWS_BYTES // (8 * r)))
     rows = ctx.buffer(reserve=min(chunk, c) * r * 8)
     rows.bind_to_storage_buffer(8)
     for first in range(0, c, chunk):
