@@ -9,7 +9,7 @@ How a vertex is evaluated. Cycles bakes a point attribute at every face corner, 
 the corners of each vertex. A voxel method cannot resolve light closer to a surface than about one cell: at a room's
 corner the cell that holds the vertex also holds the neighbouring wall, and it sees into it (evaluated exactly at the
 vertices the Cornell box's bake is 0.39-0.42 rel-L1 from Cycles', far too dark). So each corner is evaluated at the
-vertex moved INSET_CELLS cells of the method's grid (1.8 for LPV, 1.0 for VCT) toward its face's centre (at most
+vertex moved INSET_CELLS cells of the method's grid (1.2 for LPV, 1.0 for VCT) toward its face's centre (at most
 INSET_LIMIT of the way there, so a small face keeps its sample inside), with the corner's normal, and the corners are
 averaged per vertex, as Cycles does. Method "none" has no grid and is evaluated at the vertices. The measured errors
 are in the README.
@@ -31,7 +31,7 @@ from .preview import PreviewError, one_line, render_settings_of, wait_result
 ATTRIBUTE = "BounceGI"
 # How far a corner's sample moves toward its face's centre, in cells of the method's grid: where each method's
 # light is no longer that of the neighbouring surface's cell (chosen on cornell, spot_room, courtyard; README).
-INSET_CELLS = {"lpv": 1.8, "vct": 1.0}
+INSET_CELLS = {"lpv": 1.2, "vct": 1.0}
 INSET_LIMIT = 0.45  # ... but at most this fraction of the way to the centre
 EXTRACT_SIZE = (64, 64)  # the bake renders no image; extraction wants a size
 
