@@ -51,7 +51,7 @@ BENCH_OUT ?= benchmarks/results/llvmpipe
 bench: setup
 	$(PY) examples/build_examples.py out/ex $(BENCH_SCENES)
 	$(VENV)/bin/bounce-gi bench $(BENCH_SCENES:%=out/ex/%.blend) --res 160 120 --out $(BENCH_OUT)
-	$(VENV)/bin/bounce-gi bench out/ex/cornell.blend --incremental --res 160 120 --out $(BENCH_OUT)
+	$(VENV)/bin/bounce-gi bench $(BENCH_SCENES:%=out/ex/%.blend) --incremental --res 160 120 --out $(BENCH_OUT)
 	$(VENV)/bin/bounce-gi bench --scaling > $(BENCH_OUT)/scaling.md
 	cp $(BENCH_OUT)/quality_front.json addon/quality_front.json
 

@@ -3,7 +3,8 @@
 
 An update is what the add-on does after an edit: extract the evaluated scene, then `Engine.render`, whose pass cache
 re-runs only the passes whose inputs changed (gpu_kernels/gl/pass_cache.py). Each kind of edit is applied to the open
-.blend with bpy (+d each time, then undone), and the median of `repeats` updates is reported with every run.
+.blend with bpy (+d, +2d, … from the scene as it was, then restored exactly), and the median of `repeats`
+updates is reported with every run.
 Beside them: Cycles re-rendering the same scene at 1 sample + OpenImageDenoise (the peer an edit must beat), and
 what the LPV's cached transport holds in memory at a few grid resolutions. The file is never saved.
 """
@@ -49,9 +50,22 @@ def _base_color_socket(material):
     return None
 
 
+def _stepper(get, put, value_at):
+    """edit(k): the value saved now, `k` steps on (value_at(base, k)); edit(0) restores it exactly."""
+    base = get()
+    return lambda k: put(value_at(base, k))
+
+
+def _channel(values, index):
+    """(get, put) of one channel of a colour or vector property."""
+    def put(v):
+        values[index] = v
+    return (lambda: values[index]), put
+
+
 def _world_edit(scene):
-    """An edit of the world: its Background node's colour (or the world's viewport colour) nudged; a world of
-    strength 0 is switched on (strength 1) by the first edit."""
+    """An edit of the world: its Background node's blue (or the world's viewport colour's) nudged; a world of
+    strength 0 is switched on (strength 1) while edited."""
     world = scene.world
     if world is None:
         return "the scene has no world"
@@ -59,37 +73,35 @@ def _world_edit(scene):
     sock = node.inputs.get("Color") if node is not None else None
     if sock is not None and sock.is_linked:
         return "the world's colour is driven by a node tree (a sky texture), not a value to nudge"
-
     strength = node.inputs.get("Strength") if node is not None else None
+    colour = _stepper(*_channel(sock.default_value if sock is not None else world.color, 2),
+                      lambda base, k: base + k * STEP)
+    power = None if strength is None else strength.default_value
 
-    def recolour(sign):
-        if strength is not None and strength.default_value == 0:
-            strength.default_value = 1.0  # a world switched off: it stays on (once), its colour is the edit
-        if sock is not None:
-            sock.default_value[2] = max(0.0, sock.default_value[2] + sign * STEP)
-        else:
-            world.color[2] = max(0.0, world.color[2] + sign * STEP)
-    return recolour
+    def edit(k):
+        if strength is not None:
+            strength.default_value = power if k == 0 or power > 0 else 1.0
+        colour(k)
+    return edit
 
 
 def _edits(bpy):
-    """kind → a function edit(sign) applying a small change, or a reason the scene has nothing to edit."""
+    """kind → a function edit(k) applying the k-th small change from the scene as it is now (edit(0) restores it),
+    or a reason the scene has nothing to edit."""
     scene = bpy.context.scene
     meshes = [o for o in scene.objects if o.type == "MESH" and o.visible_get()]
     lights = [o for o in scene.objects if o.type == "LIGHT" and o.visible_get()]
     edits = {}
 
     def mover(obj, axis):
-        def edit(sign):
-            obj.location[axis] += sign * STEP
-        return edit
+        return _stepper(*_channel(obj.location, axis), lambda base, k: base + k * STEP)
 
     edits["camera_only"] = mover(scene.camera, 0) if scene.camera else "the scene has no camera"
     edits["light_move"] = mover(lights[0], 0) if lights else "the scene has no light object (emission only)"
     if lights:
-        def brighten(sign):
-            lights[0].data.energy *= 1.25 if sign > 0 else 0.8  # undone exactly: 1.25 × 0.8 = 1
-        edits["light_power"] = brighten
+        data = lights[0].data
+        edits["light_power"] = _stepper(lambda: data.energy, lambda v: setattr(data, "energy", v),
+                                        lambda base, k: base * 1.25 ** k)
     else:
         edits["light_power"] = "the scene has no light object (emission only)"
     edits["world_change"] = _world_edit(scene)
@@ -101,14 +113,11 @@ def _edits(bpy):
         edits["object_move"] = "the scene has no mesh object"
     material = next((s.material for o in meshes for s in o.material_slots if s.material), None)
     socket = _base_color_socket(material) if material else None
-    if socket is not None:
-        def recolour(sign):
-            socket.default_value[0] = min(1.0, max(0.0, socket.default_value[0] + sign * STEP))
-        edits["material_change"] = recolour
-    elif material is not None:
-        def recolour_viewport(sign):
-            material.diffuse_color[0] = min(1.0, max(0.0, material.diffuse_color[0] + sign * STEP))
-        edits["material_change"] = recolour_viewport
+    if material is not None:
+        values = socket.default_value if socket is not None else material.diffuse_color
+        # darker each step where a few brighter steps would leave [0, 1]
+        edits["material_change"] = _stepper(*_channel(values, 0), lambda base, k: base + (
+            k * STEP if base + 4 * STEP <= 1.0 else -k * STEP))
     else:
         edits["material_change"] = "no mesh has a material"
     return edits
@@ -144,13 +153,12 @@ def measure_incremental(scene_resolution, method: str, repeats: int = 3) -> dict
             out[kind], detail[kind] = None, {"note": edit}
             continue
         runs = []
-        for _ in range(repeats):  # always onward: the cache keeps a pass's last outputs, so going back and forth
-            edit(1)               # would find the previous state cached instead of measuring an edit
+        for k in range(1, repeats + 1):  # always onward: the cache keeps a pass's last outputs, so going back
+            edit(k)                      # and forth would find the previous state cached, not measure an edit
             bpy.context.view_layer.update()
             runs.append(_update(engine, settings, scene_resolution))
         record(kind, runs)
-        for _ in range(repeats):
-            edit(-1)  # leave the scene as it was, and the engine's cache in step with it,
+        edit(0)  # the scene exactly as it was, and the engine's cache in step with it,
         bpy.context.view_layer.update()  # so the next kind measures its own edit only
         _update(engine, settings, scene_resolution)
     return {**{k: out.get(k) for k in KINDS}, "detail": detail}

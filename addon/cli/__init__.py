@@ -90,6 +90,8 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("--out", help="directory for plots, summary.md, quality_front.json (default: ./bounce-gi-bench)")
     b.add_argument("--json", action="store_true")
     b.add_argument("--incremental", action="store_true", help="time updates by kind of edit in one engine")
+    b.add_argument("--methods", nargs="+", choices=("none", "lpv", "vct"), default=["none", "lpv", "vct"],
+                   help="with --incremental: the methods to time (default: all)")
     b.add_argument("--scaling", action="store_true", help="time against triangles, grid size and resolution")
     b.add_argument("--no-eevee", action="store_true", help="skip the EEVEE peer (minutes on a software GL)")
     b.set_defaults(func=cmd_bench)

@@ -31,7 +31,7 @@ def cmd_bench(args) -> dict:
 
 def bench_incremental(args) -> dict:
     paths = [check_blend_path(p) for p in args.scenes]
-    report = {"incremental": [run_incremental(p, args.res, ("none", "lpv", "vct"), progress,
+    report = {"incremental": [run_incremental(p, args.res, tuple(args.methods), progress,
                                               1 if args.quick else 3) for p in paths]}
     if args.out:
         text = "".join(format_incremental(e) for e in report["incremental"])
