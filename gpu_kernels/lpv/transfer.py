@@ -9,12 +9,13 @@ receiver voxel and cluster on the GPU (MODE_TRANSFER) and read back: the transfe
 edit of the lights or the world costs only:
 
     Φ_1        the RSM's VPL flux binned into the clusters (flux kept exactly)
-    E_world    the world light, propagated and absorbed as before (re-run only when the world changes)
+    E_world    the world's colour × the response to a unit world (propagated and absorbed once per geometry)
     Φ_2        = reflect(E_world) + M_ρ Φ_1,   Φ_(k+1) = M_ρ Φ_k      (C × C per channel: microseconds)
     E_total    = E_world + T · (Φ_1 + Φ_2 + … + Φ_N)                 (one product with T)
 
 where reflect(E) sums albedo × area × E over each cluster's voxel sides, and M_ρ = reflect ∘ T, the cluster-to-
-cluster transfer with the receivers' albedo (re-built on a material edit, without re-voxelising). This is the
+cluster transfer with the receivers' albedo (re-built on a material edit, which re-voxelises only the albedo:
+occupancy and T are kept). A geometry edit updates T (update_transfer) instead of rebuilding it. This is the
 precomputed-radiosity factorisation of Enlighten-style systems (Martin and Einarsson, "A real-time radiosity
 architecture for video games", SIGGRAPH 2010 course), evaluated live. Every bounce is computed (no tail
 extrapolation); the series stops once a bounce adds less than `epsilon` of the first reflection's flux.
