@@ -18,7 +18,7 @@ cluster transfer with the receivers' albedo (re-built on a material edit, which 
 occupancy and T are kept). A geometry edit updates T (update_transfer) instead of rebuilding it. This is the
 precomputed-radiosity factorisation of Enlighten-style systems (Martin and Einarsson, "A real-time radiosity
 architecture for video games", SIGGRAPH 2010 course), evaluated live. Every bounce is computed (no tail
-extrapolation); the series stops once a bounce adds less than `epsilon` of the first reflection's flux.
+extrapolation); the series stops once a bounce adds less than `epsilon` of the largest pass's flux.
 
 Memory: T holds 2 × C × R float32 (R surface voxels); C shrinks to fit `transfer_mb`, and below MIN_CLUSTERS the
 transport falls back to the per-bounce gather (lpv/gather.py).
