@@ -91,20 +91,17 @@ def _match(old: np.ndarray, new: np.ndarray) -> np.ndarray:
     return np.array([old_keys.get(row.tobytes(), -1) for row in new], np.int64)
 
 
-def changed_box(prior, gv, grid: Grid):
-    """The box (2, 3) around every fine voxel that differs between `prior`'s receivers and `gv`'s (appeared,
-    vanished, or another normal or area), grown by an LPV cell (a cell's visibility planes come from the voxels in
-    it); None when nothing changed."""
-    def voxels(cells, normals, areas):
-        return np.concatenate([cells.astype(np.float64), normals, areas[:, None]], axis=1)
-    old = voxels(prior.cells, prior.normals, prior.areas)
-    new = voxels(gv.cells, gv.surface_normal, gv.surface_area)
-    gone = old[_match(new, old) < 0, :3]
-    came = new[_match(old, new) < 0, :3]
-    moved = np.concatenate([gone, came])
+def _voxels(cells, normals, areas) -> np.ndarray:
+    """(R, 7) rows a receiver is compared by: its fine voxel, normal and area."""
+    return np.concatenate([cells.astype(np.float64), normals, areas[:, None]], axis=1)
+
+
+def changed_box(moved: np.ndarray, fine: Grid, grid: Grid):
+    """The box (2, 3) around the fine voxels `moved` (cells that appeared, vanished, or got another normal or
+    area), grown by an LPV cell (a cell's visibility planes come from the voxels in it); None when none did."""
     if len(moved) == 0:
         return None
-    centre = np.asarray(gv.fine.origin) + (moved + 0.5) * gv.fine.cell
+    centre = np.asarray(fine.origin) + (moved + 0.5) * fine.cell
     return np.stack([centre.min(axis=0) - grid.cell, centre.max(axis=0) + grid.cell])
 
 
@@ -115,10 +112,12 @@ def update_transfer(ctx, programs, gv, grid: Grid, occlusion: bool, prior) -> tu
     from .clusters import make_clusters
 
     new = make_clusters(gv.cells, gv.surface_normal, gv.surface_area, gv.fine, 0, block=prior.clusters.block)
-    old_r = _match(np.concatenate([prior.cells, prior.normals, prior.areas[:, None]], axis=1),
-                   np.concatenate([gv.cells, gv.surface_normal, gv.surface_area[:, None]], axis=1))
+    before, after = _voxels(prior.cells, prior.normals, prior.areas), _voxels(gv.cells, gv.surface_normal,
+                                                                              gv.surface_area)
+    old_r = _match(before, after)
     old_c = _match(prior.clusters.records, new.records)
-    box = changed_box(prior, gv, grid)
+    gone = _match(after, before) < 0
+    box = changed_box(np.concatenate([before[gone, :3], after[old_r < 0, :3]]), gv.fine, grid)
     if box is None:
         box = np.zeros((2, 3))
     matrix = build_transfer(ctx, programs, gv, grid, new, occlusion, (old_r < 0, old_c < 0, box))
