@@ -5,6 +5,8 @@ Run in a subprocess by the `compare_examples` fixture (tests/conftest.py) for te
 stays out of the pytest process:
     python tests/support/compare_examples.py SAMPLES NAME [NAME...] [--method lpv|vct] [--bounces N]
                                              [--lpv KEY=VALUE ...] [--vct KEY=VALUE ...]
+A NAME is an example scene (examples.scenes.SCENES) or a test scene as `module:function` (build below). Besides
+rel-L1 and noise floors, each report holds the ratio Σ ours / Σ Cycles per compared pass.
 """
 import json
 import os
@@ -36,16 +38,40 @@ def main():
     args = parser.parse_args()
     out = {}
     for name in args.names:
-        scenes.build(name)
+        build(name)
         scene = extract_scene(bpy.context.evaluated_depsgraph_get())
         report, result, ref, mask = compare(scene, args.method, args.samples, args.bounces, progress=lambda m: None,
                                             lpv_options=parse_method_options(args.lpv),
                                             vct_settings=vct_options(args.vct))
         if args.snapshot:
             add_snapshot(report, scene, args, result, ref, mask)
+        add_ratios(report, result, ref, mask)
         out[name] = report
     sys.stdout.flush()
     print("RESULT " + json.dumps(out), flush=True)
+
+
+def build(name):
+    """An example scene by its name, or a test scene as `module:function` (e.g.
+    `tests.support.emitter_scenes:lamp_room`, built by that module's build())."""
+    if ":" not in name:
+        scenes.build(name)
+        return
+    import importlib
+
+    module, function = name.split(":", 1)
+    importlib.import_module(module).build(function)
+
+
+def add_ratios(report, result, ref, mask):
+    """report["ratio"][key] = Σ ours / Σ Cycles over the compared pixels and channels, per compared pass: whether
+    a pass is too bright or too dark in total, which rel-L1 alone does not say."""
+    from bounce_gi.addon.reference.compare import COMPARED
+
+    report["ratio"] = {}
+    for pass_name, key in COMPARED:
+        r = float(ref.passes[pass_name][mask][..., :3].sum())
+        report["ratio"][key] = float(result.passes[pass_name][mask][..., :3].sum()) / r if r > 0 else float("nan")
 
 
 def add_snapshot(report, scene, args, result, ref, mask):
