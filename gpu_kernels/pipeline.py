@@ -4,7 +4,9 @@
 Passes and their inputs (a pass re-runs only when one of its inputs changed — see gl/pass_cache.py):
     geometry      ← scene geometry
     textures      ← materials (images)
-    shadow_maps   ← geometry, materials (emissive triangles), lights, shadow settings
+    emitter_shells← geometry, materials (closed emitters: common/emitters.py)
+    shadow_maps   ← geometry, materials (emissive triangles), lights, shadow settings, which closed emitters hold
+                    the camera
     gbuffer       ← geometry, materials, camera, resolution
     direct_light  ← gbuffer, shadow_maps
     <method>      ← the above (lpv/passes.py, vct/passes.py: the indirect light)
@@ -22,6 +24,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from .common import emitters as em
 from .compose import compose_passes
 from .direct import gbuffer as gb
 from .direct import geometry as geo
@@ -226,9 +229,17 @@ class Pipeline:
                 "world": hash_parts(scene.world)}
         geometry = cache.run("geometry", (keys["geometry"],), lambda: geo.upload_geometry(ctx, programs, scene))
         textures = cache.run("textures", (keys["materials"],), lambda: geo.upload_textures(ctx, scene))
-        keys["shadow"] = (keys["geometry"], keys["materials"], keys["lights"], repr(settings.shadow))
+        # Closed emitters trap their inner light unless the camera is inside one (common/emitters.py): the shells
+        # depend on geometry and materials only, and the shadow maps on which of them hold the camera, which
+        # changes only when the camera crosses one.
+        shells = cache.run("emitter_shells", (keys["geometry"], keys["materials"]), lambda: em.sealed_shells(scene))
+        camera = None if scene.camera is None else np.asarray(scene.camera.matrix_world, np.float64)[:3, 3]
+        around = em.shells_around(scene, shells, camera)
+        trapping = [s for k, s in enumerate(shells) if k not in around]
+        keys["shadow"] = (keys["geometry"], keys["materials"], keys["lights"], repr(settings.shadow), around)
         shadows = cache.run("shadow_maps", keys["shadow"],
-                            lambda: sh.render_shadow_atlas(ctx, programs, scene, geometry, settings.shadow))
+                            lambda: sh.render_shadow_atlas(ctx, programs, scene, geometry, settings.shadow,
+                                                           trapping))
         keys["gbuffer"] = (keys["geometry"], keys["materials"], keys["camera"])
         if samples is None:
             gbuffer = cache.run("gbuffer", keys["gbuffer"], lambda: gb.render_gbuffer(

@@ -8,6 +8,9 @@ Units follow Cycles (docs/conventions.md; intern/cycles/scene/light.cpp):
 - emissive triangles: radiance = material emission (colour × strength), emitted from both sides as in Cycles.
 Area lights and emissive triangles are "polygon lights", integrated exactly (Lambert's polygon formula) in the shader,
 shadowed by a few sample points on the light, each with a six-view shadow cube (the documented approximation).
+Emissive triangles are grouped into a bounded number of clusters (common/emitters.py), each one polygon light whose
+polygon is a list of triangles with their own radiance, shadowed from its own sample points on both sides of the
+surface: every emissive triangle is shadowed, and the shadow cubes stay within ShadowSettings.emissive_sample_budget.
 
 Every numpy dtype here mirrors a GLSL struct in shaders/common/lights.glsl field for field (std430).
 """
@@ -19,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import camera as cam
+from . import emitters as em
 from ..scene import Light, Scene
 
 LIGHT_SUN, LIGHT_POINT, LIGHT_SPOT, LIGHT_POLYGON = 0, 1, 2, 3
@@ -26,7 +30,7 @@ LIGHT_SUN, LIGHT_POINT, LIGHT_SPOT, LIGHT_POLYGON = 0, 1, 2, 3
 LIGHT_DTYPE = np.dtype([("color_type", "<f4", 4), ("position", "<f4", 4), ("direction", "<f4", 4),
                         ("params", "<f4", 4), ("polygon", "<f4", 4)])
 VIEW_DTYPE = np.dtype([("view_projection", "<f4", (4, 4)), ("tile", "<f4", 4), ("origin", "<f4", 4),
-                       ("info", "<f4", 4)])
+                       ("info", "<f4", 4), ("emitter", "<f4", 4)])
 DISK_SEGMENTS = 32
 CUBE_DIRECTIONS = [(np.array(f), np.array(u)) for f, u in (
     ((1, 0, 0), (0, -1, 0)), ((-1, 0, 0), (0, -1, 0)), ((0, 1, 0), (0, 0, 1)),
@@ -40,8 +44,9 @@ class ShadowSettings:
     cube_resolution: int = 512  # per face, point lights
     sample_cube_resolution: int = 256  # per face, area/emissive sample points
     area_samples: int = 2  # n×n shadow sample points on square/rectangle lights (n² ring points on disks)
-    max_shadowed_emissive: int = 16  # emissive triangles beyond this light unshadowed (a warning says so)
-    emissive_sample_budget: int = 64  # shadow cubes for all emissive triangles together
+    # Shadow cubes for all emissive triangles together: they form ≤ budget/2 clusters (common/emitters.py), each
+    # shadowed from 1–4 sample points on each of its two sides.
+    emissive_sample_budget: int = 64
     pcf_radius: int = 1  # PCF kernel (2r+1)²
 
 
@@ -55,6 +60,11 @@ class ShadowView:
     far: float = 0.0  # perspective: depth is stored as distance / far; 0 for orthographic
     view_matrix: np.ndarray | None = None  # world → view (rows: right, up, −forward)
     half_extent: float = 0.0  # tan(half fov) (perspective) or half width in metres (orthographic)
+    # Polygon lights' sample points: the normal the light emits along there and the share of the light's area the
+    # point stands for (the weights of direct/eval.glsl's polygon_visibility), negative where the sample faces the
+    # sealed inside of a closed emitter (its light is trapped there: common/emitters.py); zero for other lights.
+    emit_normal: np.ndarray | None = None
+    emit_share: float = 0.0
 
 
 @dataclass
@@ -122,15 +132,6 @@ def area_sample_points(light: Light, n: int) -> np.ndarray:
     return pts[:, :3]
 
 
-def triangle_sample_points(tri: np.ndarray, count: int) -> np.ndarray:
-    """1 point (the centroid) or 4 (centroids of the four midpoint sub-triangles) on a triangle."""
-    if count == 1:
-        return tri.mean(axis=0, keepdims=True)
-    a, b, c = tri
-    ab, bc, ca = (a + b) / 2, (b + c) / 2, (c + a) / 2
-    return np.array([(a + ab + ca) / 3, (ab + b + bc) / 3, (ca + bc + c) / 3, (ab + bc + ca) / 3])
-
-
 def _scene_radius(scene: Scene) -> tuple[np.ndarray, float]:
     lo, hi = scene.bounds()
     centre = (lo + hi) / 2
@@ -142,8 +143,10 @@ def _scene_radius(scene: Scene) -> tuple[np.ndarray, float]:
     return centre, max(float(np.linalg.norm(hi - lo)) / 2, floor)
 
 
-def cube_views(origin, resolution: int, near: float, far: float) -> list[ShadowView]:
-    """Six perspective views around `origin`, each a little wider than 90° so PCF never reads past a face edge."""
+def cube_views(origin, resolution: int, near: float, far: float, emit_normal=None, emit_share: float = 0.0
+               ) -> list[ShadowView]:
+    """Six perspective views around `origin`, each a little wider than 90° so PCF never reads past a face edge.
+    A polygon light's sample point passes the normal it emits along and the share of the light it stands for."""
     margin = 1.0 + 4.0 * 2 / resolution  # two texels of margin on each side
     fov = 2 * math.atan(margin)
     proj = cam.perspective(fov, 1.0, near, far)
@@ -151,7 +154,7 @@ def cube_views(origin, resolution: int, near: float, far: float) -> list[ShadowV
     for fwd, up in CUBE_DIRECTIONS:
         view = cam.look_at(origin, np.asarray(origin) + fwd, up)
         views.append(ShadowView(proj @ view, np.asarray(origin, np.float64), False,
-                                2 * margin / resolution, resolution, far, view, margin))
+                                2 * margin / resolution, resolution, far, view, margin, emit_normal, emit_share))
     return views
 
 
@@ -183,22 +186,6 @@ def _near_far(scene: Scene, origin) -> tuple[float, float]:
     return far * 1e-4, far  # relative only: a metre-valued floor here clipped millimetre scenes' shadow maps
 
 
-def emissive_triangles(scene: Scene) -> tuple[np.ndarray, np.ndarray]:
-    """Indices of triangles whose material emits, and their emitted radiance (RGB), brightest power first."""
-    if scene.triangle_count == 0 or not scene.materials:
-        return np.zeros(0, np.int64), np.zeros((0, 3))
-    emission = np.array([m.emission for m in scene.materials], np.float64).reshape(-1, 3)
-    idx = np.nonzero(emission[scene.material_index].max(axis=1) > 0)[0]
-    if len(idx) == 0:
-        return idx, np.zeros((0, 3))
-    p = scene.positions[idx].astype(np.float64)
-    area = 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
-    radiance = emission[scene.material_index[idx]]
-    order = np.argsort(-(radiance.sum(axis=1) * area), kind="stable")
-    keep = area[order] > 0
-    return idx[order][keep], radiance[order][keep]
-
-
 class _Records:
     """The light records, shadow views and polygon vertices being packed, in the order the shaders read them."""
 
@@ -213,22 +200,28 @@ class _Records:
         rec["position"] = (*position, radius)
         rec["direction"] = (*direction, cos_half)
         rec["params"] = (smooth, len(self.views), samples, per)
-        if poly is not None:
-            rec["polygon"] = (sum(len(p) for p in self.polys), len(poly), 1.0 if two_sided else 0.0, 0)
-            self.polys.append(np.asarray(poly, np.float64))
+        if poly is not None:  # (V, 3) one polygon, or (4T, 4) a triangle list (triangle_list_vertices)
+            poly = np.asarray(poly, np.float64)
+            is_list = poly.shape[1] == 4
+            if not is_list:
+                poly = np.concatenate([poly, np.ones((len(poly), 1))], axis=1)
+            rec["polygon"] = (sum(len(p) for p in self.polys), len(poly), 1.0 if two_sided else 0.0,
+                              1.0 if is_list else 0.0)
+            self.polys.append(poly)
         self.views.extend(light_views)
         self.view_lights.extend([len(self.records)] * len(light_views))
         self.records.append(rec)
 
     def finish(self) -> LightBuffers:
         lights = np.array(self.records, LIGHT_DTYPE) if self.records else np.zeros(0, LIGHT_DTYPE)
-        vertices = np.concatenate(self.polys) if self.polys else np.zeros((0, 3))
-        vertices = np.concatenate([vertices, np.ones((len(vertices), 1))], axis=1).astype(np.float32)
+        vertices = (np.concatenate(self.polys) if self.polys else np.zeros((0, 4))).astype(np.float32)
         return LightBuffers(lights, self.views, vertices, self.warnings, self.view_lights, self.skipped)
 
 
-def build_light_buffers(scene: Scene, settings: ShadowSettings | None = None) -> LightBuffers:
-    """Pack every light (and emissive triangle) into GPU records and list the shadow views they sample."""
+def build_light_buffers(scene: Scene, settings: ShadowSettings | None = None, trapping: list | None = None
+                        ) -> LightBuffers:
+    """Pack every light (and emissive triangle) into GPU records and list the shadow views they sample.
+    `trapping`: the closed emitters whose inner light is trapped (default emitters.trapping_shells(scene))."""
     s = settings or ShadowSettings()
     out = _Records()
     for light in scene.lights:
@@ -237,7 +230,7 @@ def build_light_buffers(scene: Scene, settings: ShadowSettings | None = None) ->
             out.skipped.append(f"light '{light.name}': {reason}")
             continue
         _add_lamp(out, scene, light, s)
-    _add_emissive(out, scene, s)
+    _add_emissive(out, scene, s, trapping)
     return out.finish()
 
 
@@ -284,40 +277,38 @@ def _add_lamp(out: _Records, scene: Scene, light: Light, s: ShadowSettings) -> N
         v = []
         pts = area_sample_points(light, s.area_samples) if light.cast_shadow else []
         for point in pts:
-            v.extend(cube_views(point, s.sample_cube_resolution, *_near_far(scene, point)))
+            v.extend(cube_views(point, s.sample_cube_resolution, *_near_far(scene, point),
+                                np.asarray(light.direction, np.float64), 1.0 / len(pts)))
         out.add(LIGHT_POLYGON, radiance, poly.mean(axis=0), 0.0, light.direction, light_views=v,
                 samples=len(pts), per=6, poly=poly)
     else:
         out.warnings.append(f"light '{light.name}' of type {light.type} is not supported and is ignored")
 
 
-def _add_emissive(out: _Records, scene: Scene, s: ShadowSettings) -> None:
-    """Every emissive triangle as a two-sided polygon light; the brightest max_shadowed_emissive are shadowed."""
-    tri_idx, radiance = emissive_triangles(scene)
-    shadowed = min(len(tri_idx), s.max_shadowed_emissive)
-    # Few emitters get 4 shadow points per side (centroids of the midpoint subdivision) for softer, truer
-    # penumbrae; many get one, so the number of shadow cubes stays within the budget.
-    per_side = 4 if shadowed * 2 * 4 <= s.emissive_sample_budget else 1
-    for rank, (t, rad) in enumerate(zip(tri_idx, radiance)):
-        tri = scene.positions[t].astype(np.float64)
-        centroid = tri.mean(axis=0)
-        normal = np.cross(tri[1] - tri[0], tri[2] - tri[0])
-        normal /= np.linalg.norm(normal)
-        v, samples = [], 0
-        if rank < shadowed:
-            # Sample points nudged off the surface so the triangle does not shadow itself; they alternate sides
-            # (even: along the normal, odd: against it) as direct/light.glsl expects of two-sided emitters.
-            eps = 1e-3 * max(float(np.linalg.norm(tri[1] - tri[0])), 1e-3)
-            for point in triangle_sample_points(tri, per_side):
-                for side in (1.0, -1.0):
-                    p = point + side * eps * normal
-                    v.extend(cube_views(p, s.sample_cube_resolution, *_near_far(scene, p)))
-                    samples += 1
-        out.add(LIGHT_POLYGON, rad, centroid, 0.0, normal, light_views=v, samples=samples, per=6, poly=tri,
-                two_sided=True)
-    if len(tri_idx) > s.max_shadowed_emissive:
-        out.warnings.append(f"{len(tri_idx) - s.max_shadowed_emissive} of {len(tri_idx)} emissive triangles light "
-                            "the scene without shadows (only the brightest are shadowed)")
+def triangle_list_vertices(vertices: np.ndarray, radiance: np.ndarray, color: np.ndarray) -> np.ndarray:
+    """(4T, 4) polygon-buffer rows of a triangle list: per triangle its three vertices (w = 1), then its radiance
+    relative to the light record's colour (rgb; w = 0). shaders/common/light_eval.glsl reads them."""
+    t = len(vertices)
+    out = np.zeros((t, 4, 4))
+    out[:, :3, :3] = vertices
+    out[:, :3, 3] = 1.0
+    out[:, 3, :3] = np.divide(radiance, color, out=np.zeros_like(radiance), where=color > 0)
+    return out.reshape(-1, 4)
+
+
+def _add_emissive(out: _Records, scene: Scene, s: ShadowSettings, trapping: list | None) -> None:
+    """Every emissive triangle, in ≤ emissive_sample_budget/2 two-sided polygon lights (common/emitters.py), each
+    shadowed from its sample points on both sides of the surface."""
+    half = max(1, s.emissive_sample_budget // 2)
+    for c in em.cluster_emitters(scene, half, half, trapping):
+        color = c.radiance.max(axis=0)
+        v, samples = [], em.side_samples(c)
+        for point, normal, share, trapped in samples:
+            # A trapped sample's share is stored negative (direct/eval.glsl, common/emitters.py: trapped light).
+            v.extend(cube_views(point, s.sample_cube_resolution, *_near_far(scene, point), normal,
+                                (-1.0 if trapped else 1.0) * share / c.area))
+        out.add(LIGHT_POLYGON, color, c.centroid, 0.0, c.normal, light_views=v, samples=len(samples), per=6,
+                poly=triangle_list_vertices(c.vertices, c.radiance, color), two_sided=True)
 
 
 def pack_views(views: list[ShadowView], tiles: list[tuple], atlas_size: tuple[int, int], pcf_radius: int,
@@ -333,6 +324,8 @@ def pack_views(views: list[ShadowView], tiles: list[tuple], atlas_size: tuple[in
         # The atlas may have shrunk the tile: a texel then covers resolution/w times more ground.
         light = view_lights[i] if view_lights is not None else 0
         out[i]["info"] = (v.texel_world * v.resolution / w, pcf_radius, v.far, light)
+        if v.emit_normal is not None:
+            out[i]["emitter"] = (*v.emit_normal, v.emit_share)
     return out
 
 

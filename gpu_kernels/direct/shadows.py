@@ -29,11 +29,12 @@ class ShadowAtlas:
 
 
 def render_shadow_atlas(ctx, programs, scene: Scene, geometry: GeometryBuffers,
-                        settings: lb.ShadowSettings) -> ShadowAtlas:
-    """Render every light's shadow views into one depth atlas and upload the light/view/polygon buffers."""
+                        settings: lb.ShadowSettings, trapping: list | None = None) -> ShadowAtlas:
+    """Render every light's shadow views into one depth atlas and upload the light/view/polygon buffers.
+    `trapping`: the closed emitters whose inner light is trapped (common/emitters.trapping_shells)."""
     import moderngl
 
-    buffers = lb.build_light_buffers(scene, settings)
+    buffers = lb.build_light_buffers(scene, settings, trapping)
     max_size = ctx.info.get("GL_MAX_TEXTURE_SIZE", 16384)
     tiles, size, scale = lb.allocate_atlas([v.resolution for v in buffers.views], max_height=max_size)
     warnings = list(buffers.warnings)

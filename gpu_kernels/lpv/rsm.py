@@ -50,8 +50,14 @@ def flux_bound(buffers: lb.LightBuffers) -> float:
             total += color * 4 * math.pi
         else:
             first, count, two_sided = int(rec["polygon"][0]), int(rec["polygon"][1]), rec["polygon"][2] > 0.5
-            p = buffers.polygon_vertices[first:first + count, :3].astype(np.float64)
-            area = 0.5 * np.linalg.norm(sum(np.cross(p[j], p[(j + 1) % count]) for j in range(count)))
+            rows = buffers.polygon_vertices[first:first + count].astype(np.float64)
+            if rec["polygon"][3] > 0.5:  # a triangle list: Σ area × its largest relative radiance
+                t = rows.reshape(-1, 4, 4)
+                areas = 0.5 * np.linalg.norm(np.cross(t[:, 1, :3] - t[:, 0, :3], t[:, 2, :3] - t[:, 0, :3]), axis=1)
+                area = float((areas * t[:, 3, :3].max(axis=1)).sum())
+            else:
+                p = rows[:, :3]
+                area = 0.5 * np.linalg.norm(sum(np.cross(p[j], p[(j + 1) % count]) for j in range(count)))
             total += color * math.pi * area * (2 if two_sided else 1)
     return max(total, 1e-12)
 
@@ -69,13 +75,17 @@ def view_resolution(resolution: int, ortho: bool, samples: int) -> int:
 
 
 def render_rsm(ctx, programs, scene: Scene, geometry, textures, shadows, resolution: int) -> Rsm:
-    """Render every shadow view of every light once more as an RSM (position, normal, albedo) into an atlas."""
+    """Render every shadow view of every light once more as an RSM (position, normal, albedo) into an atlas —
+    except the views of samples whose light is trapped inside a closed emitter (common/emitters.py): their VPLs
+    would light only its inside, and the volume would let that light out."""
     import moderngl
 
     buffers = shadows.buffers
-    views = buffers.views
+    kept = [i for i, v in enumerate(buffers.views) if not v.emit_share < 0]
+    views = [buffers.views[i] for i in kept]
+    view_lights = [buffers.view_lights[i] for i in kept]
     res = [view_resolution(resolution, v.ortho, int(buffers.lights[light]["params"][2]))
-           for v, light in zip(views, buffers.view_lights)]
+           for v, light in zip(views, view_lights)]
     tiles, size, scale = lb.allocate_atlas(res, max_height=ctx.info.get("GL_MAX_TEXTURE_SIZE", 16384))
     targets = [ctx.texture(size, 4, dtype="f4") for _ in range(3)]
     for t in targets:
@@ -98,9 +108,9 @@ def render_rsm(ctx, programs, scene: Scene, geometry, textures, shadows, resolut
         set_uniform(prog, "u_ortho", bool(view.ortho))
         set_uniform(prog, "u_view_index", float(i))
         draw_by_material(prog, scene, geometry, textures, vao=vao)
-        light = buffers.view_lights[i]
+        light = view_lights[i]
         rec = buffers.lights[light]
-        k = (i - int(rec["params"][1])) // max(int(rec["params"][3]), 1)
+        k = (kept[i] - int(rec["params"][1])) // max(int(rec["params"][3]), 1)
         records[i]["params"] = (0.0 if view.ortho else view.half_extent,
                                 2 * view.half_extent / w if view.ortho else 0.0, light, k)
         records[i]["origin"] = (*view.origin, 1.0 if view.ortho else 0.0)

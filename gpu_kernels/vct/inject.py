@@ -1,7 +1,9 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """vct_inject: the direct light reflected through every voxel face. Surface points are rasterised along their
 dominant axis and lit exactly as the Diffuse Direct pass lights pixels (direct/eval.glsl), then averaged per face
-(Crassin et al. 2011 inject direct light from shadow maps into the voxels; here each voxel face is lit itself)."""
+(Crassin et al. 2011 inject direct light from shadow maps into the voxels; here each voxel face is lit itself).
+Emission itself is never injected (emissive triangles are lights, so their light is in E already), and the light a
+closed emitter traps inside itself is left out (common/emitters.py: it would leak out through the voxels)."""
 from __future__ import annotations
 
 import math
@@ -38,7 +40,7 @@ def inject(ctx, programs, scene: Scene, geometry, textures: list, vox, shadows, 
         prog = programs.raster("vct/inject_raster.glsl")
         side = max(grid.size) * INJECT_SAMPLES
         bind_grid(prog, grid, 1)
-        bind_lights(prog, shadows, unit=2)
+        bind_lights(prog, shadows, unit=2, exclude_trapped=True)
         set_uniforms(prog, {"u_samples": float(INJECT_SAMPLES), "u_viewport": (float(side), float(side))})
         acc.bind_to_image(0, read=True, write=True)
         vao = ctx.vertex_array(prog, [(geometry.vbo, "3f 12x 2f 12x", "in_position", "in_uv")])
@@ -58,7 +60,7 @@ def inject(ctx, programs, scene: Scene, geometry, textures: list, vox, shadows, 
             unit = bind_samplers(prog, "u_area", [vox.area], 0)
             unit = bind_samplers(prog, "u_albedo", [vox.albedo], unit)
             unit = bind_samplers(prog, "u_acc", [acc], unit)
-            bind_lights(prog, shadows, unit)
+            bind_lights(prog, shadows, unit, exclude_trapped=True)
             bind_grid(prog, grid, 1)
             for i, t in enumerate(outputs):
                 t.bind_to_image(i, read=False, write=True)

@@ -108,7 +108,7 @@ void main() {
     for (int i = 0; i < shadow_views.length(); ++i) {
         ShadowView v = shadow_views[i];
         out_v[k++] = v.view_projection * u_point;
-        out_v[k++] = v.tile; out_v[k++] = v.origin; out_v[k++] = v.info;
+        out_v[k++] = v.tile; out_v[k++] = v.origin; out_v[k++] = v.info; out_v[k++] = v.emitter;
     }
     for (int i = 0; i < polygon_vertices.length(); ++i) out_v[k++] = polygon_vertices[i];
 }
@@ -123,6 +123,7 @@ def test_gpu_reads_numpy_records_field_for_field(gl, tmp_path):
     # Views made the way the pipeline makes them: row-major float64 matrices packed by pack_views.
     views = [lb.ShadowView(rng.uniform(-2, 2, (4, 4)), rng.uniform(-5, 5, 3), bool(i % 2), 0.01 * (i + 1), 256,
                            far=3.0 + i) for i in range(2)]
+    views[1].emit_normal, views[1].emit_share = np.array([0.0, 0.6, -0.8]), -0.25  # a trapped polygon-light sample
     tiles = [(0, 0, 256, 256), (256, 0, 256, 256)]  # tiles at the views' own resolution (atlas not scaled)
     packed = lb.pack_views(views, tiles, (512, 256), pcf_radius=2)
     polygon = rng.uniform(-1, 1, (5, 4)).astype(np.float32)
@@ -132,7 +133,7 @@ def test_gpu_reads_numpy_records_field_for_field(gl, tmp_path):
     prog = gl.compute_shader(spp.preprocess(src, search_dirs=[spp.SHADER_DIR]).text)
     point = np.array([0.3, -1.2, 2.5, 1.0])
     prog["u_point"].value = tuple(point)
-    n_out = 1 + 5 * len(lights) + 4 * len(packed) + len(polygon)
+    n_out = 1 + 5 * len(lights) + 5 * len(packed) + len(polygon)
     bufs = [gl.buffer(lights.tobytes()), gl.buffer(packed.tobytes()), gl.buffer(polygon.tobytes()),
             gl.buffer(reserve=16 * n_out)]
     for i, b in enumerate(bufs):
@@ -155,7 +156,9 @@ def test_gpu_reads_numpy_records_field_for_field(gl, tmp_path):
         np.testing.assert_allclose(out[k + 1], (x / 512, y / 256, w / 512, h / 256), rtol=1e-7)
         np.testing.assert_allclose(out[k + 2], (*v.origin, 1.0 if v.ortho else 0.0), rtol=1e-6)
         np.testing.assert_allclose(out[k + 3], (v.texel_world, 2, v.far, 0), rtol=1e-6)
-        k += 4
+        np.testing.assert_allclose(out[k + 4], (0, 0, 0, 0) if v.emit_normal is None else (*v.emit_normal,
+                                                                                          v.emit_share), rtol=1e-6)
+        k += 5
     np.testing.assert_array_equal(out[k:k + len(polygon)], polygon)
 
 
@@ -320,6 +323,11 @@ def test_build_light_buffers_units_and_views():
     for v in buf.views[1:7]:
         np.testing.assert_allclose(v.origin, point.matrix_world[:3, 3])
     area_pts = np.array([v.origin for v in buf.views[8:]])
+    # Each area sample point emits along the light's direction and stands for a quarter of it (polygon_visibility).
+    for v in buf.views[8:]:
+        np.testing.assert_allclose(v.emit_normal, area.direction, atol=1e-12)
+        assert v.emit_share == pytest.approx(0.25)
+    assert all(v.emit_normal is None for v in buf.views[:8])
     plane_n = area.matrix_world[:3, 2] / np.linalg.norm(area.matrix_world[:3, 2])
     assert np.abs((area_pts - area.matrix_world[:3, 3]) @ plane_n).max() < 1e-9
 

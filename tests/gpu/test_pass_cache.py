@@ -110,7 +110,7 @@ def test_downstream_keys_rerun_transitively():
 SUN_STRENGTH = 3.0
 FLOOR_ALBEDO = (0.5, 0.4, 0.3)
 BOX = (np.array([-0.5, -0.5, 0.0]), np.array([0.5, 0.5, 1.0]))
-ALL_PASSES = {"geometry", "textures", "shadow_maps", "gbuffer", "direct_light", "compose"}
+ALL_PASSES = {"geometry", "textures", "emitter_shells", "shadow_maps", "gbuffer", "direct_light", "compose"}
 
 
 def _quad(a, b, c, d, normal):
@@ -250,7 +250,7 @@ def test_pipeline_reruns_only_what_changed(engine, settings):
     # Move only the light: shadows and lighting re-run; geometry, textures and the G-buffer do not.
     moved = make_scene(sun(-50.0), cam1)
     third = engine.render(moved, settings)
-    assert set(third.skipped) == {"geometry", "textures", "gbuffer"}
+    assert set(third.skipped) == {"geometry", "textures", "emitter_shells", "gbuffer"}
     assert {"shadow_maps", "direct_light", "compose"}.isdisjoint(third.skipped)
     check_direct(third.passes, moved.lights[0], -50.0)
     np.testing.assert_array_equal(third.passes["Position"], first.passes["Position"])
@@ -259,7 +259,7 @@ def test_pipeline_reruns_only_what_changed(engine, settings):
     cam2 = camera((3.0, -6.0, 7.0))
     turned = make_scene(sun(-50.0), cam2)
     fourth = engine.render(turned, settings)
-    assert set(fourth.skipped) == {"geometry", "textures", "shadow_maps"}
+    assert set(fourth.skipped) == {"geometry", "textures", "emitter_shells", "shadow_maps"}
     assert not np.array_equal(fourth.passes["Position"], third.passes["Position"])
     check_direct(fourth.passes, turned.lights[0], -50.0)
 

@@ -9,6 +9,8 @@ the example registry: they are test cases, not examples.
 - `lamp_room_open`: the same room with the shade plus an open emitter: a bent two-sided emissive strip (three
   quads at angles) standing on the cabinet, whose both sides light the room.
 
+- `lamp_room_albedo`: the shade reflects too (diffuse albedo 0.8 under its emission).
+
 compare_examples.py builds them by the name `tests.support.emitter_scenes:<function>`.
 """
 import math
@@ -100,6 +102,22 @@ def lamp_room_open():
     verts = [(p.x, p.y, z0) for p in pts] + [(p.x, p.y, z1) for p in pts]
     faces = [(i, i + 1, i + 5, i + 4) for i in range(3)]
     mesh_object("Strip", verts, faces, strip)
+
+
+def lamp_room_albedo():
+    """The room lit by a closed shade that also reflects: a Principled BSDF (base colour 0.8, Specular IOR Level 0,
+    so purely diffuse) with the same emission. Its inside is lit by its own emission and keeps that light."""
+    _base()
+    mat = bpy.data.materials.new("ShadePrincipled")
+    mat.use_nodes = True
+    bsdf = next(n for n in mat.node_tree.nodes if n.bl_idname == "ShaderNodeBsdfPrincipled")
+    bsdf.inputs["Base Color"].default_value = (0.8, 0.8, 0.8, 1.0)
+    bsdf.inputs["Roughness"].default_value = 1.0
+    bsdf.inputs["Specular IOR Level"].default_value = 0.0
+    bsdf.inputs["Emission Color"].default_value = (1.0, 0.85, 0.6, 1.0)
+    bsdf.inputs["Emission Strength"].default_value = SHADE_STRENGTH
+    mat.diffuse_color = (0.8, 0.8, 0.8, 1.0)
+    closed_cylinder("LampShade", SHADE_RADIUS, SHADE_HEIGHT, SHADE_CENTRE, SHADE_SEGMENTS, mat)
 
 
 def build(name):

@@ -20,6 +20,16 @@ int cube_face(vec3 d) {
     return d.z > 0.0 ? 4 : 5;
 }
 
+// One edge's term of Lambert's formula, angle(a, b) · n·normalize(a × b), for a, b relative to the receiver; atan2
+// for the angle so short edges stay accurate.
+float lambert_edge(vec3 a, vec3 b, vec3 n) {
+    a = normalize(a);
+    b = normalize(b);
+    vec3 c = cross(a, b);
+    float s = length(c);
+    return s < 1e-12 ? 0.0 : atan(s, dot(a, b)) * dot(n, c) / s;
+}
+
 // ∫ over the polygon of cosθ dω (projected solid angle), polygon clipped to the upper hemisphere of n.
 // Lambert's formula: Σ_edges angle(v_i, v_j) · n·normalize(v_i × v_j) / 2 (Arvo 1995, "Applications of irradiance
 // tensors"), with atan2 for the edge angle so short edges stay accurate.
@@ -43,14 +53,44 @@ float polygon_projected_solid_angle(int first, int count, vec3 p, vec3 n) {
     }
     if (m < 3) return 0.0;
     float sum = 0.0;
-    for (int i = 0; i < m; ++i) {
-        vec3 a = normalize(clipped[i]);
-        vec3 b = normalize(clipped[(i + 1) % m]);
-        vec3 c = cross(a, b);
-        float s = length(c);
-        if (s < 1e-12) continue;
-        sum += atan(s, dot(a, b)) * dot(n, c) / s;
-    }
+    for (int i = 0; i < m; ++i) sum += lambert_edge(clipped[i], clipped[(i + 1) % m], n);
     return abs(sum) * 0.5;
+}
+
+// The part of edge a→b above the plane (heights ha, hb), appended to q (one Sutherland–Hodgman step).
+void clip_edge(vec3 a, vec3 b, float ha, float hb, inout vec3 q[4], inout int m) {
+    if (ha >= 0.0 && m < 4) q[m++] = a;
+    if ((ha >= 0.0) != (hb >= 0.0) && m < 4) q[m++] = a + (b - a) * (ha / (ha - hb));
+}
+
+// polygon_projected_solid_angle of one triangle (vertices relative to the receiver), without loops: an emitter
+// cluster holds many, and llvmpipe caps a shader invocation's loop iterations (docs/conventions.md).
+float triangle_projected_solid_angle(vec3 a, vec3 b, vec3 c, vec3 n) {
+    float ha = dot(a, n), hb = dot(b, n), hc = dot(c, n);
+    if (max(ha, max(hb, hc)) <= 1e-5 * max(length(a), max(length(b), length(c)))) return 0.0;
+    vec3 q[4];
+    int m = 0;
+    clip_edge(a, b, ha, hb, q, m);
+    clip_edge(b, c, hb, hc, q, m);
+    clip_edge(c, a, hc, ha, q, m);
+    if (m < 3) return 0.0;
+    float sum = lambert_edge(q[0], q[1], n) + lambert_edge(q[1], q[2], n);
+    sum += m == 4 ? lambert_edge(q[2], q[3], n) + lambert_edge(q[3], q[0], n) : lambert_edge(q[2], q[0], n);
+    return abs(sum) * 0.5;
+}
+
+// A polygon light's ∫ (radiance / color) cosθ dω at p: its polygon's projected solid angle, or for a triangle list
+// (an emitter cluster, polygon.w = 1) the sum over its triangles, each weighted by its own relative radiance.
+// Irradiance = color_type.rgb × this (unshadowed).
+vec3 polygon_light_solid_angle(GpuLight L, vec3 p, vec3 n) {
+    int first = int(L.polygon.x), count = int(L.polygon.y);
+    if (L.polygon.w < 0.5) return vec3(polygon_projected_solid_angle(first, count, p, n));
+    vec3 sum = vec3(0.0);
+    for (int i = first; i < first + count; i += 4) {
+        float psa = triangle_projected_solid_angle(polygon_vertices[i].xyz - p, polygon_vertices[i + 1].xyz - p,
+                                                   polygon_vertices[i + 2].xyz - p, n);
+        sum += psa * polygon_vertices[i + 3].rgb;
+    }
+    return sum;
 }
 

@@ -14,7 +14,9 @@ struct GpuLight {
     vec4 position;        // xyz: position (point/spot) or polygon centroid; w: r² of a soft-falloff light
     vec4 direction;       // xyz: unit direction the light points along (sun/spot/polygon normal); w: cos half spot angle
     vec4 params;          // x: spot smoothstep scale; y: first shadow view; z: shadow sample count; w: views per sample
-    vec4 polygon;         // x: first polygon vertex; y: vertex count; z: two-sided (1) or one-sided (0); w: unused
+    vec4 polygon;         // x: first polygon vertex; y: vertex count; z: two-sided (1) or one-sided (0);
+                          // w: 0 one polygon, 1 a list of y/4 triangles (an emitter cluster, common/emitters.py):
+                          //    per triangle three vertices, then its radiance relative to color_type.rgb
 };
 
 struct ShadowView {
@@ -23,6 +25,8 @@ struct ShadowView {
     vec4 origin;          // xyz: eye position (perspective) ; w: 1 if orthographic
     vec4 info;            // x: texel world size at unit distance (perspective) or absolute (ortho); y: PCF radius in texels; w: index of its light;
                           // z: far distance (perspective: stored depth = distance / far)
+    vec4 emitter;         // polygon lights' sample points: xyz the normal the light emits along there, w the share
+                          // of the light's area the point stands for (polygon_visibility's weights); else 0
 };
 
 layout(std430, binding = 0) readonly buffer LightBuffer { GpuLight lights[]; };

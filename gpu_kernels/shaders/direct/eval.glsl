@@ -8,6 +8,10 @@
 
 uniform sampler2DShadow u_shadow_atlas;
 uniform vec2 u_atlas_texel;        // 1 / atlas size
+// true for VCT's injection: the samples facing the sealed inside of a closed emitter (ShadowView.emitter.w < 0)
+// count as shadowed, since that light is trapped inside and the voxels would let it out (common/emitters.py).
+// The Diffuse Direct pass leaves it false and lights the inside exactly.
+uniform bool u_exclude_trapped;
 
 // Visibility of world point p from one shadow view with a normal-offset bias and percentage-closer filtering.
 // The offset grows with the shadow texel's world footprint, which removes acne without a hand-tuned constant.
@@ -57,30 +61,27 @@ float cube_visibility(int first_view, vec3 p, vec3 geo_n) {
     return view_visibility(first_view + cube_face(q - origin), p, geo_n, to_light);
 }
 
-// Weighted visibility of a polygon light from its shadow sample points: each sample is weighted by its own
-// unshadowed point contribution (cosθ_light · cosθ_receiver / d²), so samples that light p more count more.
+// Weighted visibility of a polygon light from its shadow sample points: each sample k stands for a share A_k of the
+// light's area around it and emits along n_k (ShadowView.emitter), so it is weighted by its own unshadowed point
+// contribution A_k · max(0, n_k·ω) · max(0, n·−ω) / d². A two-sided emitter has a sample on each side of its
+// surface, each speaking only for receivers on its own side; a closed shell's inner samples see only its inside.
+// A trapped sample keeps its weight but sees nothing when u_exclude_trapped is set.
 float polygon_visibility(GpuLight L, vec3 p, vec3 n, vec3 geo_n) {
     int samples = int(L.params.z);
     if (samples == 0) return 1.0;
     int first = int(L.params.y);
     int per = int(L.params.w);
-    vec3 ln = L.direction.xyz;
-    bool two_sided = L.polygon.z > 0.5;
     float wsum = 0.0, vsum = 0.0;
     for (int k = 0; k < samples; ++k) {
         int view0 = first + k * per;
-        vec3 o = shadow_views[view0].origin.xyz;
-        vec3 d = p - o;
+        vec4 e = shadow_views[view0].emitter;
+        vec3 d = p - shadow_views[view0].origin.xyz;
         float d2 = max(dot(d, d), 1e-8);
         vec3 w = d * inversesqrt(d2);
-        // Two-sided emitters have one sample per side (even k: along the normal, odd k: against it); a sample
-        // only speaks for receivers on its own side.
-        vec3 side_n = (two_sided && (k % 2 == 1)) ? -ln : ln;
-        float cl = max(dot(side_n, w), 0.0);
-        float weight = cl * max(dot(n, -w), 0.0) / d2;
+        float weight = abs(e.w) * max(dot(e.xyz, w), 0.0) * max(dot(n, -w), 0.0) / d2;
         if (weight <= 0.0) continue;
         wsum += weight;
-        vsum += weight * cube_visibility(view0, p, geo_n);
+        if (!(u_exclude_trapped && e.w < 0.0)) vsum += weight * cube_visibility(view0, p, geo_n);
     }
     return wsum > 0.0 ? vsum / wsum : 1.0;
 }
@@ -119,8 +120,8 @@ vec3 light_irradiance(GpuLight L, vec3 p, vec3 n, vec3 geo_n) {
     // Polygon light: one-sided lights shine along `direction` only.
     vec3 from_light = p - L.position.xyz;
     if (L.polygon.z < 0.5 && dot(from_light, L.direction.xyz) <= 0.0) return vec3(0.0);
-    float psa = polygon_projected_solid_angle(int(L.polygon.x), int(L.polygon.y), p, n);
-    if (psa <= 0.0) return vec3(0.0);
+    vec3 psa = polygon_light_solid_angle(L, p, n);
+    if (max(psa.r, max(psa.g, psa.b)) <= 0.0) return vec3(0.0);
     float vis = shadowed ? polygon_visibility(L, p, n, geo_n) : 1.0;
     return color * psa * vis;
 }

@@ -61,26 +61,24 @@ vec3 vpl_flux(RsmView v, vec3 p, vec3 n, vec3 albedo) {
         return albedo * color * att * texel_solid_angle(v, p) * d2 / (d2 + L.position.w);
     }
     // Polygon light seen from sample point k: this RSM carries the share w_k/Σw_j of the exact irradiance, where
-    // w_j = cosθ_light,j · cosθ_surface,j / d_j² (the same weights as the shadow test). E_k·A simplifies to
-    // E · cosθ_light,k · Ω / Σw_j, with no division by the grazing cosine.
-    float psa = polygon_projected_solid_angle(int(L.polygon.x), int(L.polygon.y), p, n);
-    if (psa <= 0.0) return vec3(0.0);
+    // w_j = A_j · cosθ_light,j · cosθ_surface,j / d_j² (the same weights as the shadow test, direct/eval.glsl).
+    // E_k·A simplifies to E · A_k · cosθ_light,k · Ω / Σw_j, with no division by the grazing cosine.
+    vec3 psa = polygon_light_solid_angle(L, p, n);
+    if (max(psa.r, max(psa.g, psa.b)) <= 0.0) return vec3(0.0);
     int first = int(L.params.y), per = int(L.params.w), samples = int(L.params.z);
-    bool two_sided = L.polygon.z > 0.5;
-    float wsum = 0.0, cos_k = 0.0;
+    float wsum = 0.0, share_k = 0.0;
     int k = int(v.params.w);
     for (int j = 0; j < samples; ++j) {
-        vec3 o = shadow_views[first + j * per].origin.xyz;
-        vec3 d = p - o;
+        vec4 e = shadow_views[first + j * per].emitter;
+        vec3 d = p - shadow_views[first + j * per].origin.xyz;
         float d2 = max(dot(d, d), 1e-8);
         vec3 w = d * inversesqrt(d2);
-        vec3 side_n = (two_sided && (j % 2 == 1)) ? -L.direction.xyz : L.direction.xyz;
-        float cl = max(dot(side_n, w), 0.0);
+        float cl = abs(e.w) * max(dot(e.xyz, w), 0.0);  // e.w < 0: trapped (lpv/rsm.py renders no RSM for it)
         wsum += cl * max(dot(n, -w), 0.0) / d2;
-        if (j == k) cos_k = cl;
+        if (j == k) share_k = cl;
     }
     if (wsum <= 0.0) return vec3(0.0);
-    return albedo * color * psa * cos_k * texel_solid_angle(v, p) / wsum;
+    return albedo * color * psa * share_k * texel_solid_angle(v, p) / wsum;
 }
 
 void main() {

@@ -1,0 +1,125 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Emissive meshes (issue 17), on the surface atlas's texels against exact oracles:
+(a) a closed emissive shade lights a floor from its outer side only, exactly as much as the triangles facing each
+    point send (emission is two-sided, but a closed convex shell hides every inner side from outside);
+(b) a closed non-emissive box around the shade lets no light out: every emissive triangle is shadowed;
+(c) the light a closed shade emits inwards stays there in the indirect methods too: a white shade (albedo 0.8) and a
+    black one inject the same flux into VCT's voxels and give the floor the same indirect light (LPV, VCT); with the
+    camera inside the shade, that light is what it sees, and VCT injects it.
+"""
+import math
+
+import numpy as np
+import pytest
+
+from bounce_gi.gpu_kernels.common import camera as cam
+from bounce_gi.gpu_kernels.engine import Engine
+from bounce_gi.gpu_kernels.scene import Camera, Material, Scene
+from bounce_gi.gpu_kernels.settings import RenderSettings
+from bounce_gi.gpu_kernels.surface.gbuffer import surface_points
+from bounce_gi.gpu_kernels.vct.settings import VctSettings
+from bounce_gi.tests.support.synthetic import box_quads, closed_cylinder, quad, triangle_projected_solid_angles
+
+BUDGET = 20000
+LE = 3.0  # the shade's radiance
+CENTRE = np.array([0.0, 0.0, 1.2])
+
+
+@pytest.fixture(scope="module")
+def engine():
+    e = Engine()
+    yield e
+    e.shutdown()
+
+
+def shade_scene(shade_albedo=0.0, container=False, eye=(2.5, -2.5, 1.6)):
+    """A 6 × 6 m white floor at z = 0 and the closed 92-triangle shade (radius 0.22 m, 0.32 m tall) at 1.2 m,
+    optionally inside a closed grey box; the camera at `eye`."""
+    shade = closed_cylinder(centre=CENTRE)
+    parts = [(quad([(-3, -3, 0), (3, -3, 0), (3, 3, 0), (-3, 3, 0)], (0, 0, 1)), 0), (shade, 1)]
+    mats = [Material("floor", (0.8, 0.8, 0.8)), Material("shade", (shade_albedo,) * 3, emission=(LE,) * 3)]
+    if container:
+        parts += box_quads(CENTRE - 0.4, CENTRE + 0.4, 2, inward=False)
+        mats.append(Material("box", (0.5, 0.5, 0.5)))
+    pos = np.concatenate([p for p, _ in parts]).astype(np.float32)
+    n = np.cross(pos[:, 1] - pos[:, 0], pos[:, 2] - pos[:, 0])
+    n = np.repeat((n / np.linalg.norm(n, axis=1, keepdims=True))[:, None], 3, axis=1).astype(np.float32)
+    index = np.concatenate([np.full(len(p), m, np.int32) for p, m in parts])
+    c2w = np.linalg.inv(cam.look_at(eye, CENTRE * [1, 1, 0.5], (0, 0, 1)))
+    return Scene(pos, n, np.zeros((len(pos), 3, 2), np.float32), index, mats, camera=Camera(c2w, lens=20.0))
+
+
+def floor_texels(scene, r, atlas=None):
+    atlas = atlas or r.atlas
+    points = surface_points(scene, atlas)
+    ys, xs = np.nonzero(np.isin(atlas.triangle, [0, 1]))
+    return ys, xs, points["position"][ys, xs].astype(np.float64)
+
+
+def test_a_closed_shade_lights_the_floor_from_its_outer_side_only(engine):
+    scene = shade_scene()
+    r = engine.submit_surface(scene, RenderSettings("none", 64, 64), BUDGET).result()
+    ys, xs, p = floor_texels(scene, r)
+    keep = np.arange(0, len(p), 7)
+    ys, xs, p = ys[keep], xs[keep], p[keep]
+    shade = closed_cylinder(centre=CENTRE).astype(np.float64)
+    psa = triangle_projected_solid_angles(p, np.tile([0.0, 0.0, 1.0], (len(p), 1)), shade)
+    cross = np.cross(shade[:, 1] - shade[:, 0], shade[:, 2] - shade[:, 0])
+    facing = ((p[:, None] - shade.mean(axis=1)[None]) * cross[None]).sum(-1) > 0  # outer side towards the point
+    exact = LE * (psa * facing).sum(1) / math.pi
+    both_sides = LE * psa.sum(1) / math.pi  # what an unshadowed two-sided shade would give
+    ours = r.direct[ys, xs, 0].astype(np.float64)
+    ratio, rel_l1 = ours.sum() / exact.sum(), np.abs(ours - exact).sum() / exact.sum()
+    print(f"floor under a closed shade: Σ ours / Σ exact {ratio:.4f}, rel-L1 {rel_l1:.4f}; unshadowed two-sided "
+          f"would be {both_sides.sum() / exact.sum():.3f}×; {len(p)} texels")
+    assert len(p) > 200 and both_sides.sum() > 1.5 * exact.sum()  # the inner sides matter: the test can fail
+    # The exact integral per triangle, the shadows from 1–4 sample points per side of each cluster (measured: ratio
+    # 1.0000, rel-L1 0.005; before issue 17, with the brightest 16 triangles shadowed, 1.72 and 0.72).
+    assert ratio == pytest.approx(1.0, abs=0.02)
+    assert rel_l1 < 0.03
+
+
+def test_a_closed_box_around_the_shade_lets_no_light_out(engine):
+    open_ = engine.submit_surface(shade_scene(), RenderSettings("none", 64, 64), BUDGET).result()
+    scene = shade_scene(container=True)
+    r = engine.submit_surface(scene, RenderSettings("none", 64, 64), BUDGET).result()
+    ys, xs, p = floor_texels(scene, r)
+    lit = open_.direct[floor_texels(shade_scene(), open_)[:2]][:, 0]
+    ours = r.direct[ys, xs, 0]
+    print(f"floor outside a closed box around the shade: mean {ours.mean():.3g}, max {ours.max():.3g}, "
+          f"{(ours > 0).sum()} of {len(ours)} texels lit (without the box: mean {lit.mean():.3g})")
+    # Measured: 4 of 16562 texels get 1.7% of the unboxed mean (a shadow-filter artefact at four symmetric points),
+    # all the others exactly 0. Shadowing only the brightest 16 of the 92 triangles (before issue 17) lit every
+    # texel, at 83% of the unboxed mean.
+    assert ours.mean() <= 1e-4 * lit.mean()
+    assert ours.max() <= 0.05 * lit.mean()
+
+
+def _floor_indirect(engine, scene, method):
+    settings = RenderSettings(method, 64, 64, vct=VctSettings(resolution=32, bounces=1))
+    r = engine.submit_surface(scene, settings, BUDGET).result()
+    ys, xs, _ = floor_texels(scene, r, r.indirect_atlas)
+    return r, float(r.indirect[ys, xs, 0].mean())
+
+
+@pytest.mark.parametrize("method", ["vct", "lpv"])
+def test_the_light_a_closed_shade_emits_inwards_stays_inside(engine, method):
+    """The white shade's outer side gets no direct light (convex, lit by nothing else), so what it adds to the black
+    shade's result is its outer side reflecting the floor's light (LPV's propagation bounces it), and voxel faces
+    VCT lights at their centre for want of raster samples (vct/inject.glsl), which see the shade from just outside
+    it. With the camera inside the shade its inner light is what the camera sees and is kept: that is how much the
+    inner light adds when it is not left out."""
+    black_r, black = _floor_indirect(engine, shade_scene(0.0), method)
+    white_r, white = _floor_indirect(engine, shade_scene(0.8), method)
+    inside_r, inside = _floor_indirect(engine, shade_scene(0.8, eye=CENTRE + [0.05, 0.0, 0.0]), method)
+    share = (white - black) / (inside - black)
+    print(f"{method}: floor's Diffuse Indirect, black shade {black:.5f}, white {white:.5f}, white with its inner light "
+          f"kept {inside:.5f}: the white shade adds {share:.3f} of what its inner light would")
+    assert inside > black + 0.2 * abs(black) + 1e-4  # the inner light would leak out: the test can fail
+    # Measured 0.047 (VCT) and 0.091 (LPV; before issue 17 both 1.0: nothing was left out).
+    assert share < 0.15
+    if method == "vct":  # the direct light injected into the voxels (VCT's first bounce)
+        fb, fw, fi = (x.info["bounces"][0]["flux"][0] for x in (black_r, white_r, inside_r))
+        print(f"vct injected flux: black {fb:.4f} W, white {fw:.4f} W, white with its inner light kept {fi:.4f} W")
+        assert fi > 2 * fb
+        assert fw - fb < 0.08 * (fi - fb)  # measured 0.048 (the voxel faces lit at their centre)
