@@ -123,3 +123,75 @@ def test_the_light_a_closed_shade_emits_inwards_stays_inside(engine, method):
         print(f"vct injected flux: black {fb:.4f} W, white {fw:.4f} W, white with its inner light kept {fi:.4f} W")
         assert fi > 2 * fb
         assert fw - fb < 0.08 * (fi - fb)  # measured 0.048 (the voxel faces lit at their centre)
+
+
+# --------------------------------------------------------------------------- the triangle-list polygon light
+
+PSA_PROBE = """
+#version 430 core
+#include "common/lights.glsl"
+#include "common/light_eval.glsl"
+layout(local_size_x = 1) in;
+layout(std430, binding = 3) readonly buffer Probe { vec4 probe[]; };   // per probe: point, normal
+layout(std430, binding = 4) writeonly buffer Out { vec4 out_v[]; };
+void main() {
+    int i = int(gl_GlobalInvocationID.x);
+    vec3 p = probe[2 * i].xyz, n = probe[2 * i + 1].xyz;
+    GpuLight L = lights[0];
+    vec3 list = polygon_light_solid_angle(L, p, n);
+    vec3 by_triangle = vec3(0.0), as_polygons = vec3(0.0);
+    for (int t = 0; t < polygon_triangle_count(L); ++t) {
+        vec3 a, b, c, scale;
+        polygon_triangle(L, t, a, b, c, scale);
+        by_triangle += scale * triangle_projected_solid_angle(a - p, b - p, c - p, n);
+        // the same triangle as a 3-vertex polygon (lights[1 + t]) through the general clipper
+        as_polygons += scale * polygon_projected_solid_angle(int(lights[1 + t].polygon.x), 3, p, n);
+    }
+    out_v[3 * i] = vec4(list, 0.0);
+    out_v[3 * i + 1] = vec4(by_triangle, 0.0);
+    out_v[3 * i + 2] = vec4(as_polygons, 0.0);
+}
+"""
+
+
+def test_a_triangle_list_light_integrates_like_its_triangles_as_polygons(tmp_path):
+    """polygon_light_solid_angle of an emitter cluster = Σ radiance scale × the general polygon clipper's result per
+    triangle, at points that see the triangles whole, clipped by their horizon, edge-on or from behind."""
+    moderngl = pytest.importorskip("moderngl")
+    from bounce_gi.gpu_kernels.common import lights as lb
+    from bounce_gi.gpu_kernels.gl import preprocessor as spp
+
+    try:
+        ctx = moderngl.create_standalone_context(backend="egl", require=430)
+    except Exception as exc:  # no EGL / GL 4.3 here
+        pytest.skip(f"no OpenGL 4.3 context: {exc}")
+    rng = np.random.default_rng(17)
+    tris = rng.uniform(-1, 1, (5, 3, 3))
+    scale = rng.uniform(0.1, 1.0, (5, 3))
+    rows = lb.triangle_list_vertices(tris, scale, np.ones(3))
+    poly = np.concatenate([rows] + [np.concatenate([t, np.ones((3, 1))], axis=1) for t in tris]).astype(np.float32)
+    lights = np.zeros(1 + len(tris), lb.LIGHT_DTYPE)
+    lights[0]["polygon"] = (0, len(rows), 1, 1)
+    for t in range(len(tris)):
+        lights[1 + t]["polygon"] = (len(rows) + 3 * t, 3, 1, 0)
+    points = rng.uniform(-1.5, 1.5, (64, 3))
+    normals = rng.normal(size=(64, 3))
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    probe = np.zeros((64, 2, 4), np.float32)
+    probe[:, 0, :3], probe[:, 1, :3] = points, normals
+    src = tmp_path / "probe.glsl"
+    src.write_text(PSA_PROBE)
+    prog = ctx.compute_shader(spp.preprocess(src, search_dirs=[spp.SHADER_DIR]).text)
+    bufs = [ctx.buffer(lights.tobytes()), ctx.buffer(np.zeros(1, lb.VIEW_DTYPE).tobytes()),
+            ctx.buffer(poly.tobytes()), ctx.buffer(probe.tobytes()), ctx.buffer(reserve=64 * 3 * 16)]
+    for i, b in enumerate(bufs):
+        b.bind_to_storage_buffer(i)
+    prog.run(64, 1, 1)
+    out = np.frombuffer(bufs[4].read(), np.float32).reshape(64, 3, 4)[..., :3]
+    for b in bufs:
+        b.release()
+    prog.release()
+    ctx.release()
+    assert out[:, 2].max() > 0.1 and (out[:, 2] == 0).any()  # some see the light, some not at all
+    np.testing.assert_allclose(out[:, 0], out[:, 1], rtol=1e-6, atol=1e-7)
+    np.testing.assert_allclose(out[:, 1], out[:, 2], rtol=2e-4, atol=1e-6)

@@ -79,6 +79,28 @@ float triangle_projected_solid_angle(vec3 a, vec3 b, vec3 c, vec3 n) {
     return abs(sum) * 0.5;
 }
 
+// A polygon light as triangles, whatever its layout (lights.glsl, GpuLight.polygon): a fan over one polygon's
+// vertices, or an emitter cluster's list; `scale` is the triangle's radiance relative to color_type.rgb. For code
+// that integrates something other than the cosine over the light (a glossy lobe).
+int polygon_triangle_count(GpuLight L) {
+    return L.polygon.w > 0.5 ? int(L.polygon.y) / 4 : max(int(L.polygon.y) - 2, 0);
+}
+
+void polygon_triangle(GpuLight L, int t, out vec3 a, out vec3 b, out vec3 c, out vec3 scale) {
+    int first = int(L.polygon.x);
+    if (L.polygon.w > 0.5) {
+        a = polygon_vertices[first + 4 * t].xyz;
+        b = polygon_vertices[first + 4 * t + 1].xyz;
+        c = polygon_vertices[first + 4 * t + 2].xyz;
+        scale = polygon_vertices[first + 4 * t + 3].rgb;
+    } else {
+        a = polygon_vertices[first].xyz;
+        b = polygon_vertices[first + t + 1].xyz;
+        c = polygon_vertices[first + t + 2].xyz;
+        scale = vec3(1.0);
+    }
+}
+
 // A polygon light's ∫ (radiance / color) cosθ dω at p: its polygon's projected solid angle, or for a triangle list
 // (an emitter cluster, polygon.w = 1) the sum over its triangles, each weighted by its own relative radiance.
 // Irradiance = color_type.rgb × this (unshadowed).
