@@ -6,14 +6,16 @@ one is shadowed: triangles are grouped into at most `max_clusters` clusters of n
 triangles, and each cluster gets its own shadow sample points, like an area light's (common/lights.py). A cluster is
 one polygon light whose polygon is a list of triangles, each with its own radiance, so a cluster may span materials.
 
-Clustering is top-down: starting from all emissive triangles in one cluster, the cluster with the largest
-area-weighted scatter of (centroid / L, 2·axis(normal)) is split in two at its mean along its principal direction,
-until there are `max_clusters` clusters or every cluster is one triangle. L = sqrt(total emissive area / π) makes
-the split independent of the scene's scale; axis(n) = the upper triangle of n·nᵀ (|axis(a) − axis(b)|² = 2 sin²θ)
-ignores the sign of a normal, as two-sided emission does, and its weight 2 splits a cluster by orientation (a
-lamp shade's cap from its side, a cube's faces) before it splits a flat one by position.
+Clustering is top-down, over features (centroid / L, 2·axis(normal)) weighted by each triangle's emitted power
+(area × mean radiance): L = sqrt(total emissive area / π) makes it independent of the scene's scale, and
+axis(n) = the upper triangle of n·nᵀ (|axis(a) − axis(b)|² = 2 sin²θ) ignores the sign of a normal, as two-sided
+emission does. A cluster is split in two at its weighted mean along the principal direction of its features.
+First every cluster that is not flat (a normal more than FLAT_DEGREES from its axis, or thicker along that axis than
+tan(FLAT_DEGREES) × its diameter — a shade's two caps, opposite walls) is split, the largest scatter first, until all
+are flat or there are max_clusters; then any, the largest scatter first, until there are max_clusters / 4: flat
+clusters are better served by more sample points than by more clusters.
 
-Each cluster side gets 1 … MAX_SAMPLES_PER_SIDE sample points (the spare budget goes to the largest clusters), each
+Each cluster side gets 1 … MAX_SAMPLES_PER_SIDE sample points (the spare budget by emitted power), each
 at the centre of a k-means cell of the cluster's area, snapped onto the surface (a curved cluster's mean point lies
 inside it), with the normal of the triangle it lies on and the share of the cluster's area it stands for. Both sides
 of the surface get a sample there (emission is two-sided, as in Cycles), nudged off it by 1e-3 of the triangle's
@@ -23,16 +25,16 @@ emitted inwards never reaches the room.
 Trapped light. A closed emissive surface (every edge of a connected set of emissive triangles shared by an even
 number of them) whose inside holds no other geometry — a closed lamp shade — emits half its light inwards, and that
 light can only ever light the inside, which no camera outside sees (a shell around the camera, like the white
-furnace's box, traps nothing). Its inner samples are marked `trapped`: the
-Diffuse Direct pass still lights the inside exactly, but the indirect methods leave that light out (VCT's injection
-sees trapped samples as shadowed, the LPV renders no RSM for them), because the voxels would let it out: a thin shell
-is not opaque at VCT's coarse mip levels nor in the LPV's fuzzy occlusion, and the inner light reflected there
-reached the room a second time (issue 17: VCT's Diffuse Indirect 2.9× Cycles' around a closed white shade). Inside
-and outside are told apart by the parity of ray crossings (three rays, the majority wins).
+furnace's box, traps nothing). Its inner samples are marked `trapped`: the Diffuse Direct pass still lights the
+inside exactly, but the indirect methods leave that light out (VCT's injection sees trapped samples as shadowed, the
+LPV renders no RSM for them), because the voxels would let it out: a thin shell is not opaque at VCT's coarse mip
+levels nor in the LPV's fuzzy occlusion, so the light reflected inside reached the room as well (in
+tests/support/emitter_scenes.lamp_room_albedo, with every triangle shadowed but the inner light kept, Diffuse
+Indirect was 2.9× Cycles' with VCT and 1.5× with the LPV). Inside and outside are told apart by the parity of ray
+crossings (three rays, the majority wins).
 """
 from __future__ import annotations
 
-import heapq
 import math
 from dataclasses import dataclass
 
