@@ -72,7 +72,7 @@ uniform float u_grid_cell;
 uniform ivec3 u_grid_size;
 uniform int u_light_count;
 uniform vec3 u_base_color;
-uniform float u_metallic;
+uniform vec3 u_diffuse_mean;      // common/principled.py: diffuse_mean (the layers above the diffuse base)
 uniform bool u_use_texture;
 uniform sampler2D u_base_texture;
 in vec3 g_world;
@@ -97,7 +97,7 @@ void main() {
     ivec3 v = ivec3(floor((p - u_grid_origin) / u_grid_cell));
     if (any(lessThan(v, ivec3(0))) || any(greaterThanEqual(v, u_grid_size))) return;
     vec3 color = u_use_texture ? textureLod(u_base_texture, g_uv, 0.0).rgb : u_base_color;
-    vec3 albedo = max(color, vec3(0.0)) * (1.0 - clamp(u_metallic, 0.0, 1.0));
+    vec3 albedo = max(color, vec3(0.0)) * u_diffuse_mean;
     for (int side = 0; side < 2; ++side) {
         vec3 n = side == 0 ? g_normal : -g_normal;
         vec3 e = vec3(0.0);
