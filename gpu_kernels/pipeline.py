@@ -37,6 +37,7 @@ from .scene import Scene, hash_parts
 from .settings import METHODS, RenderSettings, check_method, check_renderable
 from .surface import gbuffer as sgb
 from .surface.atlas import SurfaceAtlas
+from .common.principled import material_lut
 from .surface.mesh import draw_arrays
 from .vct import passes as vct_passes
 
@@ -70,6 +71,7 @@ class SurfaceLight:
     info: dict = field(default_factory=dict)  # the method's details, as RenderResult.info (grids, bounces)
     indirect_atlas: SurfaceAtlas | None = None  # the layout `indirect` is in (None: `atlas`)
     indirect_base: np.ndarray | None = None  # base colours in that layout
+    material_lut: np.ndarray | None = None  # the materials' Principled table (common/principled.material_lut)
 
 
 @dataclass
@@ -147,7 +149,7 @@ class Pipeline:
         self.cache.begin_frame()
         frame = self._direct_passes(scene, settings)
         direct_tex = self.cache.run("direct_light", frame.keys["direct"], lambda: lighting.render_direct_light(
-            self.ctx, self.programs, frame.gbuffer, frame.shadows))
+            self.ctx, self.programs, frame.gbuffer, frame.shadows, frame.textures.lut))
         method = METHOD_PASSES.get(settings.method)
         out = method(frame) if method else None
 
@@ -155,7 +157,7 @@ class Pipeline:
             indirect = None if out is None or out.indirect is None else read_texture(out.indirect, 4)
             return compose_passes(frame.gbuffer, direct_tex, scene.world.color,
                                   None if indirect is None else indirect[..., :3],
-                                  None if out is None or out.glossy is None else read_texture(out.glossy, 3),
+                                  None if out is None or out.glossy is None else read_texture(out.glossy, 4),
                                   indirect[..., 3] if indirect is not None and out.has_ao else None)
         passes = self.cache.run("compose", (frame.keys["direct"], out and out.key, frame.keys["world"]), compose)
         timings = dict(self.cache.timings)
@@ -188,7 +190,7 @@ class Pipeline:
         return SurfaceLight(atlas, direct, indirect, base, draw_arrays(scene, atlas, indirect_atlas), timings,
                             list(self.cache.skipped), list(scene.warnings) + list(frame.shadows.warnings),
                             settings.method, scene.statistics(), method_info(out, frame), indirect_atlas,
-                            indirect_base)
+                            indirect_base, material_lut(scene.materials))
 
     def render_points(self, scene: Scene, settings: RenderSettings, positions, normals) -> PointLight:
         """Diffuse Direct and Diffuse Indirect (irradiance / π) at N points with normals (N, 3): the passes of
@@ -211,7 +213,7 @@ class Pipeline:
         frame = self._direct_passes(scene, settings, samples)
         tex = self.cache.run("direct_light", frame.keys["direct"], lambda: lighting.render_direct_light(
             self.ctx, self.programs, frame.gbuffer, frame.shadows))
-        return read_texture(tex, 3)[::-1], frame
+        return read_texture(tex["diffuse"], 3)[::-1], frame
 
     @staticmethod
     def _method_output(frame):

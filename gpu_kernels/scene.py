@@ -33,7 +33,17 @@ class Material:
     emission: tuple = (0.0, 0.0, 0.0)  # emission colour × strength (radiance, W/(m²·sr) per unit)
     roughness: float = 0.5
     metallic: float = 0.0
-    specular_layer: bool = False  # Principled: a dielectric GGX layer takes a view-dependent share (see direct/gbuffer.glsl)
+    specular_layer: bool = False  # Principled BSDF: the layers below weigh the diffuse base (common/principled.py)
+    # Principled inputs that set the layers' albedo (Cycles' meaning and defaults):
+    ior: float = 1.5
+    specular_ior_level: float = 0.5  # 0: no dielectric specular layer; 0.5: F0 of the IOR; 1: twice that F0
+    specular_tint: tuple = (1.0, 1.0, 1.0)
+    transmission: float = 0.0
+    coat_weight: float = 0.0
+    coat_roughness: float = 0.03
+    coat_ior: float = 1.5
+    coat_tint: tuple = (1.0, 1.0, 1.0)
+    multiscatter: bool = True  # distribution Multiscatter GGX (Principled's default) rather than GGX
 
 
 @dataclass

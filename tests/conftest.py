@@ -34,18 +34,27 @@ def reference_cache(tmp_path_factory):
 
 
 @pytest.fixture(scope="session")
-def compare_examples(reference_cache, tmp_path_factory):
-    """run(samples, names, *args) → {name: compare report}: tests/support/compare_examples.py in a subprocess
-    (bpy's global state stays out of pytest), sharing the session's reference cache."""
+def support_script(reference_cache, tmp_path_factory):
+    """run(script, *args) → the JSON a tests/support script printed on its "RESULT " line, run in a subprocess (bpy's
+    global state stays out of pytest) that shares the session's reference cache."""
     user = str(tmp_path_factory.mktemp("blender_user"))
 
-    def run(samples, names, *args, timeout=900):
+    def run(script, *args, timeout=900):
         env = dict(os.environ, BOUNCE_GI_CACHE=reference_cache, BLENDER_USER_RESOURCES=user)
-        proc = subprocess.run([sys.executable, str(ROOT / "tests/support/compare_examples.py"), str(samples),
-                               *names, *map(str, args)], capture_output=True, text=True, env=env, timeout=timeout)
+        proc = subprocess.run([sys.executable, str(ROOT / "tests/support" / script), *map(str, args)],
+                              capture_output=True, text=True, env=env, timeout=timeout)
         line = next((l for l in proc.stdout.splitlines() if l.startswith("RESULT ")), None)
-        assert proc.returncode == 0 and line, f"comparison run failed:\n{proc.stdout[-3000:]}\n{proc.stderr[-3000:]}"
-        data = json.loads(line[len("RESULT "):])
+        assert proc.returncode == 0 and line, f"{script} failed:\n{proc.stdout[-3000:]}\n{proc.stderr[-3000:]}"
+        return json.loads(line[len("RESULT "):])
+
+    return run
+
+
+@pytest.fixture(scope="session")
+def compare_examples(support_script):
+    """run(samples, names, *args) → {name: compare report}: tests/support/compare_examples.py."""
+    def run(samples, names, *args, timeout=900):
+        data = support_script("compare_examples.py", samples, *names, *args, timeout=timeout)
         for name, r in data.items():
             print(name, *args, "rel-L1", {k: round(v, 3) for k, v in r["rel_l1"].items()}, "noise floor",
                   {k: round(v, 3) for k, v in r["noise_floor"].items()})

@@ -26,7 +26,8 @@ IMAGES = {"ours": "Bounce GI Compare: Ours", "cycles": "Bounce GI Compare: Cycle
           "error": "Bounce GI Compare: Error"}
 REFERENCE_BOUNCES = 8  # Cycles' bounce count: what our methods' 8 bounces are measured against
 ERROR_MAP_MAX = 0.5  # relative error shown white in the heat map (metrics.heatmap_rgb8's ramp)
-PASS_LABELS = {"combined": "Combined", "diffuse_direct": "Diffuse Direct", "diffuse_indirect": "Diffuse Indirect"}
+PASS_LABELS = {"combined": "Combined", "diffuse_direct": "Diffuse Direct", "diffuse_indirect": "Diffuse Indirect",
+               "glossy_direct": "Glossy Direct", "glossy_indirect": "Glossy Indirect"}
 
 
 @dataclass

@@ -47,7 +47,7 @@ def surface_shader():
         for name, glsl_type in (("u_view_projection", "MAT4"), ("u_eye", "VEC4"), ("u_forward", "VEC4"),
                                 ("u_params", "VEC4")):
             info.push_constant(glsl_type, name)
-        for slot, name in enumerate(("u_direct", "u_indirect")):
+        for slot, name in enumerate(("u_direct", "u_indirect", "u_material_lut")):
             info.sampler(slot, "FLOAT_2D", name)
         for slot, (name, n) in enumerate(ATTRIBUTES):
             info.vertex_in(slot, GLSL_TYPES[n], name)
@@ -77,6 +77,15 @@ def rgba_texture(pixels: np.ndarray):
     return texture
 
 
+def material_lut_of(light) -> np.ndarray:
+    """The result's Principled table (rows of μ texels); results made before it existed get a Lambertian one."""
+    lut = getattr(light, "material_lut", None)
+    if lut is None:
+        lut = np.ones((4, 2, 4), np.float32)
+        lut[1:, :, :] = 0.0
+    return lut
+
+
 @dataclass
 class View:
     """A camera for drawing: world → clip matrix (4 × 4, numpy, column vectors), eye position, unit view axis."""
@@ -97,7 +106,8 @@ class SurfaceDrawing:
         self.page_heights = (int(light.atlas.height), int(coarse.height))
         # Both pages of an atlas show the same surfaces' colours.
         self.textures = {"u_direct": rgba_texture(light.direct * np.concatenate([light.base, light.base])),
-                         "u_indirect": rgba_texture(light.indirect * np.concatenate([coarse_base, coarse_base]))}
+                         "u_indirect": rgba_texture(light.indirect * np.concatenate([coarse_base, coarse_base])),
+                         "u_material_lut": rgba_texture(material_lut_of(light))}
         self.triangles = len(light.mesh["pos"]) // 3
         self.batch = batch_for_shader(surface_shader(), "TRIS", light.mesh) if self.triangles else None
 

@@ -190,6 +190,8 @@ def draw_compare_report(layout, report: dict) -> None:
     split.split(factor=0.5).label(text="rel-L1")
     split.label(text="noise")
     for key, label in compare.PASS_LABELS.items():
+        if key not in report["rel_l1"]:
+            continue  # Cycles left the pass black (e.g. no glossy surface in view)
         split = col.split(factor=0.5)
         split.label(text=label)
         row = split.split(factor=0.5)

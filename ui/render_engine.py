@@ -38,6 +38,7 @@ PASSES = (
     ("Diffuse Direct", 3, "RGB", "COLOR"),
     ("Diffuse Indirect", 3, "RGB", "COLOR"),
     ("Diffuse Color", 3, "RGB", "COLOR"),
+    ("Glossy Direct", 3, "RGB", "COLOR"),
     ("Glossy Indirect", 3, "RGB", "COLOR"),
     ("Glossy Color", 3, "RGB", "COLOR"),
     ("Emission", 3, "RGB", "COLOR"),

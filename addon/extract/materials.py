@@ -3,7 +3,9 @@
 the image textures they use (gpu_kernels.scene.Texture).
 
 Understood: Principled BSDF and Diffuse BSDF base colour (constant, or an Image Texture through UV), emission
-colour × strength, roughness, metallic; a lone Emission shader. Anything else falls back to the material's
+colour × strength; for Principled also roughness, metallic, IOR, Specular IOR Level and Tint, transmission weight,
+coat (weight, roughness, IOR, tint) and the distribution, which set its layers' albedo (gpu_kernels/common/
+principled.py); a lone Emission shader. Anything else falls back to the material's
 viewport display colour and the returned warning names the material.
 """
 from __future__ import annotations
@@ -112,20 +114,44 @@ def read_material(material, textures: list, image_ids: dict) -> tuple[Material, 
             return fallback, f"material '{material.name}' falls back to its viewport colour: {warn}"
         return Material(material.name, color, tex, roughness=1.0), None
     if kind == "ShaderNodeBsdfPrincipled":
-        color, tex, warn = _color_input(node.inputs["Base Color"], textures, image_ids)
-        if warn:
-            return fallback, f"material '{material.name}' falls back to its viewport colour: {warn}"
-        ins = node.inputs
-        rough = float(ins["Roughness"].default_value)
-        metal = float(ins["Metallic"].default_value)
-        emission = np.array(ins["Emission Color"].default_value[:3]) * float(ins["Emission Strength"].default_value)
-        warn = None
-        if abs(float(ins["IOR"].default_value) - 1.5) > 1e-3 or abs(float(ins["Specular IOR Level"].default_value) - 0.5) > 1e-3:
-            warn = (f"material '{material.name}': the diffuse share is modelled for IOR 1.5 and Specular IOR Level 0.5; "
-                    "other values are approximated by it")
-        return Material(material.name, color, tex, tuple(emission), rough, metal, specular_layer=True), warn
+        return _read_principled(material, node, textures, image_ids, fallback)
     if kind == "ShaderNodeEmission":
         strength = float(node.inputs["Strength"].default_value)
         emission = np.array(node.inputs["Color"].default_value[:3]) * strength
         return Material(material.name, (0.0, 0.0, 0.0), emission=tuple(emission)), None
     return fallback, f"material '{material.name}' uses {node.bl_idname}; showing its viewport colour"
+
+
+def _value(ins, name, default):
+    """An unlinked input's value (a tuple for colours), or `default` on Blender versions without the input."""
+    if name not in ins:
+        return default
+    value = ins[name].default_value
+    return tuple(value[:3]) if hasattr(value, "__len__") else float(value)
+
+
+def _read_principled(material, node, textures, image_ids, fallback) -> tuple[Material, str | None]:
+    color, tex, warn = _color_input(node.inputs["Base Color"], textures, image_ids)
+    if warn:
+        return fallback, f"material '{material.name}' falls back to its viewport colour: {warn}"
+    ins = node.inputs
+    emission = np.array(ins["Emission Color"].default_value[:3]) * float(ins["Emission Strength"].default_value)
+    mat = Material(material.name, color, tex, tuple(emission), _value(ins, "Roughness", 0.5),
+                   _value(ins, "Metallic", 0.0), specular_layer=True, ior=_value(ins, "IOR", 1.5),
+                   specular_ior_level=_value(ins, "Specular IOR Level", 0.5),
+                   specular_tint=_value(ins, "Specular Tint", (1.0, 1.0, 1.0)),
+                   transmission=_value(ins, "Transmission Weight", 0.0), coat_weight=_value(ins, "Coat Weight", 0.0),
+                   coat_roughness=_value(ins, "Coat Roughness", 0.03), coat_ior=_value(ins, "Coat IOR", 1.5),
+                   coat_tint=_value(ins, "Coat Tint", (1.0, 1.0, 1.0)),
+                   multiscatter=getattr(node, "distribution", "MULTI_GGX") != "GGX")
+    linked = [n for n in ("Roughness", "Metallic", "IOR", "Specular IOR Level", "Specular Tint", "Transmission Weight",
+                          "Coat Weight", "Emission Color", "Emission Strength") if n in ins and ins[n].is_linked]
+    notes = []
+    if linked:
+        notes.append(f"{', '.join(linked)} driven by nodes (their unlinked values are used)")
+    if _value(ins, "Sheen Weight", 0.0) > 0.0:
+        notes.append("sheen is not modelled")
+    if mat.transmission > 0.0:
+        notes.append("transmission is shown as absorbed (no refraction)")
+    warn = f"material '{material.name}': " + "; ".join(notes) if notes else None
+    return mat, warn

@@ -9,7 +9,9 @@ import numpy as np
 from ...gpu_kernels.output import metrics
 
 # (pass name, report key) of the passes whose rel-L1 is reported.
-COMPARED = (("Combined", "combined"), ("Diffuse Direct", "diffuse_direct"), ("Diffuse Indirect", "diffuse_indirect"))
+COMPARED = (("Combined", "combined"), ("Diffuse Direct", "diffuse_direct"), ("Diffuse Indirect", "diffuse_indirect"),
+            ("Glossy Direct", "glossy_direct"), ("Glossy Indirect", "glossy_indirect"))
+GLOSSY_KEYS = ("glossy_direct", "glossy_indirect")
 
 
 def geometry_mask(ours: dict, ref_passes: dict) -> np.ndarray:
@@ -21,8 +23,11 @@ def compare_result(scene, result, ref, method: str, samples: int, bounces: int) 
     """(report, mask) for our RenderResult of `scene` against a cycles.Reference rendered at `samples` spp."""
     ours = result.passes
     mask = geometry_mask(ours, ref.passes)
-    errors = {key: metrics.rel_l1(ours[name], ref.passes[name], mask) for name, key in COMPARED}
-    floors = {key: ref.noise_floor(name, mask) for name, key in COMPARED}
+    # A glossy pass Cycles leaves black (no glossy closure in view) has no relative error: left out.
+    compared = [(name, key) for name, key in COMPARED if key not in GLOSSY_KEYS
+                or (name in ref.passes and np.abs(ref.passes[name][mask]).sum() > 0)]
+    errors = {key: metrics.rel_l1(ours[name], ref.passes[name], mask) for name, key in compared}
+    floors = {key: ref.noise_floor(name, mask) for name, key in compared}
     col_diff = np.abs(ours["Diffuse Color"] - ref.passes["Diffuse Color"]).max(axis=-1)
     world_warning = (["the world lights the scene in Cycles (Diffuse Direct), but method 'none' does not render "
                       "world light"] if max(scene.world.color) > 0 and method == "none" else [])

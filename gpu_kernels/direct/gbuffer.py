@@ -12,7 +12,7 @@ from ..gl.bind import set_uniform, write_uniform
 from ..scene import Scene
 from .geometry import GeometryBuffers, draw_by_material
 
-GBUFFER_TARGETS = ("position", "normal", "albedo", "emission", "geo_normal", "glossy")
+GBUFFER_TARGETS = ("position", "normal", "albedo", "emission", "geo_normal", "glossy", "specular")
 
 
 @dataclass

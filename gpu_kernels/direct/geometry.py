@@ -7,8 +7,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..common.principled import diffuse_mean, material_lut
 from ..gl.bind import set_uniform
 from ..scene import Scene
+
+LUT_UNIT = 15  # the material table's texture unit: above every pass's own samplers (GL guarantees 16 units)
 
 
 @dataclass
@@ -47,8 +50,27 @@ def upload_geometry(ctx, programs, scene: Scene) -> GeometryBuffers:
     return GeometryBuffers(vbo, vao_full, vao_depth, ranges)
 
 
-def upload_textures(ctx, scene: Scene) -> list:
-    """Material textures as float RGBA, bilinear without mipmaps (Cycles' CPU 'Linear' filtering)."""
+class MaterialTextures:
+    """What the material uniforms sample: the scene's images (indexable like Scene.textures) and the materials'
+    Principled table (common/principled.py: material_lut) with the per-material view-averaged diffuse share."""
+
+    def __init__(self, images: list, lut, diffuse_means: np.ndarray):
+        self.images, self.lut, self.diffuse_means = images, lut, diffuse_means
+
+    def __len__(self):
+        return len(self.images)
+
+    def __getitem__(self, i):
+        return self.images[i]
+
+    def release(self):
+        for t in self.images + [self.lut]:
+            t.release()
+
+
+def upload_textures(ctx, scene: Scene) -> MaterialTextures:
+    """Material textures as float RGBA, bilinear without mipmaps (Cycles' CPU 'Linear' filtering), and the
+    Principled table, filtered linearly along μ."""
     import moderngl
 
     out = []
@@ -60,17 +82,25 @@ def upload_textures(ctx, scene: Scene) -> list:
         t.filter = (f, f)
         t.repeat_x = t.repeat_y = tex.extension == "REPEAT"
         out.append(t)
-    return out
+    lut_rows = material_lut(scene.materials)
+    lut = ctx.texture((lut_rows.shape[1], lut_rows.shape[0]), 4, np.ascontiguousarray(lut_rows).tobytes(), dtype="f4")
+    lut.filter = (moderngl.LINEAR, moderngl.LINEAR)
+    lut.repeat_x = lut.repeat_y = False
+    means = np.array([diffuse_mean(m) for m in scene.materials] or [(1.0, 1.0, 1.0)], np.float32)
+    return MaterialTextures(out, lut, means)
 
 
-def bind_material(prog, scene: Scene, mat_index: int, textures: list) -> None:
+def bind_material(prog, scene: Scene, mat_index: int, textures: MaterialTextures) -> None:
     """Set the material uniforms of common/materials.glsl for one material (unused ones are skipped)."""
     mat = scene.materials[mat_index] if 0 <= mat_index < len(scene.materials) else None
     base = mat.base_color if mat else (0.8, 0.8, 0.8)
     set_uniform(prog, "u_base_color", tuple(float(c) for c in base[:3]))
-    set_uniform(prog, "u_metallic", float(mat.metallic) if mat else 0.0)
     set_uniform(prog, "u_roughness", float(mat.roughness) if mat else 0.5)
-    set_uniform(prog, "u_specular_layer", bool(mat and mat.specular_layer))
+    set_uniform(prog, "u_material", mat_index if mat else 0)
+    set_uniform(prog, "u_diffuse_mean", tuple(float(c) for c in textures.diffuse_means[mat_index if mat else 0]))
+    if "u_material_lut" in prog:
+        textures.lut.use(location=LUT_UNIT)
+        set_uniform(prog, "u_material_lut", LUT_UNIT)
     set_uniform(prog, "u_emission", tuple(float(c) for c in (mat.emission if mat else (0, 0, 0))[:3]))
     use_tex = bool(mat and 0 <= mat.base_color_texture < len(textures))
     set_uniform(prog, "u_use_texture", use_tex)

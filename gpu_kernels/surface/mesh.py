@@ -16,13 +16,13 @@ ATTRIBUTES = (("pos", 3), ("nrm", 3), ("geo", 3), ("tile", 2), ("box", 3), ("til
 def draw_arrays(scene: Scene, atlas: SurfaceAtlas, indirect_atlas: SurfaceAtlas | None = None) -> dict:
     """name → (3·T, C) float32 for every attribute of ATTRIBUTES: world position, shading normal, geometric normal,
     atlas texel coordinate and tile (origin x, y, size) in the direct light's atlas and in the indirect light's
-    (`indirect_atlas`, default the same), the material (metallic, roughness, specular layer), the emitted
+    (`indirect_atlas`, default the same), the material (its index — its rows in common/principled.material_lut —, roughness, Principled or not), the emitted
     radiance."""
     indirect_atlas = indirect_atlas or atlas
     pos = np.asarray(scene.positions, np.float32)
     t = len(pos)
     geo = np.cross(pos[:, 1] - pos[:, 0], pos[:, 2] - pos[:, 0])
-    mats = np.array([(m.metallic, m.roughness, float(m.specular_layer)) for m in scene.materials] or [(0, 0, 0)],
+    mats = np.array([(i, m.roughness, float(m.specular_layer)) for i, m in enumerate(scene.materials)] or [(0, 0, 0)],
                     np.float32)
     emits = np.array([tuple(m.emission)[:3] for m in scene.materials] or [(0, 0, 0)], np.float32)
     index = np.clip(np.asarray(scene.material_index, np.int64), 0, len(mats) - 1)

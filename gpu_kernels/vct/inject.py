@@ -11,12 +11,14 @@ import math
 import numpy as np
 
 from ..direct.geometry import draw_by_material
-from ..gl.bind import bind_grid, bind_lights, bind_samplers, dispatch, set_uniform, set_uniforms, texture3d
+from ..gl.bind import (bind_grid, bind_lights, bind_samplers, dispatch, set_uniform, set_uniforms, texture3d,
+                       zero_texture)
 from ..scene import Scene
 from .volumes import Faces
 
 
 INJECT_SAMPLES = 2  # raster samples per voxel edge: ~4 surface points per voxel face; slivers fall back (vct_inject)
+COVER_TEST_BYTES = 256 * 2 ** 20  # the front-most images' budget (32 MiB at 64³); larger grids skip the cover test
 
 
 def inject(ctx, programs, scene: Scene, geometry, textures: list, vox, shadows, levels: int) -> Faces:
@@ -37,23 +39,24 @@ def inject(ctx, programs, scene: Scene, geometry, textures: list, vox, shadows, 
         dispatch(clear, grid.size)
         ctx.memory_barrier()
 
-        prog = programs.raster("vct/inject_raster.glsl")
         side = max(grid.size) * INJECT_SAMPLES
-        bind_grid(prog, grid, 1)
-        bind_lights(prog, shadows, unit=2, exclude_trapped=True)
-        set_uniforms(prog, {"u_samples": float(INJECT_SAMPLES), "u_viewport": (float(side), float(side))})
-        acc.bind_to_image(0, read=True, write=True)
-        vao = ctx.vertex_array(prog, [(geometry.vbo, "3f 12x 2f 12x", "in_position", "in_uv")])
-        fbo = ctx.empty_framebuffer((side, side))
+        fronts = front_images(ctx, grid, side)
         try:
-            fbo.use()
-            fbo.viewport = (0, 0, side, side)
-            ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
-            draw_by_material(prog, scene, geometry, textures, vao=vao)  # material uniforms, texture unit 0
+            # The front-most surfaces first (MODE_FRONT), then the injection that leaves covered ones out.
+            for defines in (({"MODE_FRONT": None},) if fronts else ()) + ({},):
+                prog = programs.raster("vct/inject_raster.glsl", defines)
+                bind_grid(prog, grid, 1)
+                bind_lights(prog, shadows, unit=2, exclude_trapped=True)
+                set_uniforms(prog, {"u_samples": float(INJECT_SAMPLES), "u_viewport": (float(side), float(side)),
+                                    "u_cover_test": bool(fronts)})
+                acc.bind_to_image(0, read=True, write=True)
+                for i, t in enumerate(fronts):
+                    t.bind_to_image(1 + i, read=True, write=True)
+                _rasterise(ctx, prog, scene, geometry, textures, side)
+                ctx.memory_barrier()
         finally:
-            vao.release()
-            fbo.release()
-        ctx.memory_barrier()
+            for t in fronts:
+                t.release()
 
         for outputs, defines in ((faces.textures, {}), (faces.centroids, {"WRITE_CENTROIDS": None})):
             prog = programs.compute("vct/inject.glsl", {"MODE_RESOLVE": None, **defines})
@@ -70,6 +73,40 @@ def inject(ctx, programs, scene: Scene, geometry, textures: list, vox, shadows, 
         acc.release()
     faces.flux, faces.occupied, faces.missed = face_flux(ctx, programs, faces)
     return faces
+
+
+def front_images(ctx, grid, side: int) -> list:
+    """Zeroed r32ui images (side, side, 2·n_axis) for x, y, z: the front-most depth per raster column, voxel layer
+    and side (vct/inject_raster.glsl); none when they would exceed COVER_TEST_BYTES."""
+    import moderngl
+
+    if 3 * side * side * 2 * int(max(grid.size)) * 4 > COVER_TEST_BYTES:
+        return []
+    out = []
+    for n in grid.size:
+        t = ctx.texture3d((side, side, 2 * int(n)), 1, dtype="u4")
+        t.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        zero_texture(ctx, t)
+        out.append(t)
+    return out
+
+
+def _rasterise(ctx, prog, scene, geometry, textures, side: int) -> None:
+    """Draw every triangle through `prog` into an empty side × side framebuffer (the image stores are the output)."""
+    import moderngl
+
+    layout = [(geometry.vbo, "3f 12x 2f 12x", "in_position", "in_uv")] if "in_uv" in prog else \
+        [(geometry.vbo, "3f 32x", "in_position")]  # the front-most pass samples no texture
+    vao = ctx.vertex_array(prog, layout)
+    fbo = ctx.empty_framebuffer((side, side))
+    try:
+        fbo.use()
+        fbo.viewport = (0, 0, side, side)
+        ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
+        draw_by_material(prog, scene, geometry, textures, vao=vao)  # material uniforms, texture unit 0
+    finally:
+        vao.release()
+        fbo.release()
 
 
 def face_flux(ctx, programs, faces: Faces) -> tuple[list, int, int]:

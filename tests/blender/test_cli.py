@@ -18,7 +18,7 @@ import pytest
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SCRIPT = os.path.join(os.path.dirname(sys.executable), "bounce-gi")
 CLI = [SCRIPT] if os.path.exists(SCRIPT) else [sys.executable, "-m", "bounce_gi.addon.cli"]
-PASSES = {"Combined", "Diffuse Direct", "Diffuse Indirect", "Diffuse Color", "Glossy Indirect", "Glossy Color", "Emission", "AO", "Normal", "Position",
+PASSES = {"Combined", "Diffuse Direct", "Diffuse Indirect", "Diffuse Color", "Glossy Direct", "Glossy Indirect", "Glossy Color", "Emission", "AO", "Normal", "Position",
           "Depth"}
 
 MAKE_BLENDS = r"""

@@ -21,7 +21,7 @@ from support.synthetic import box_quads, quad_scene
 
 SIZE = (32, 24)
 METHODS = ("lpv", "vct")
-LIGHT_PASSES = ("Combined", "Diffuse Direct", "Diffuse Indirect", "Glossy Indirect", "Emission", "AO")
+LIGHT_PASSES = ("Combined", "Diffuse Direct", "Diffuse Indirect", "Glossy Direct", "Glossy Indirect", "Emission", "AO")
 BLOCK = ((-0.37, -0.29, 0.0), (0.23, 0.31, 1.13))  # the block inside the room (m, before scaling)
 LIGHT_AT = (0.07, -0.11, 1.67)
 BOUND_SLACK = 0.1

@@ -1,33 +1,75 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Principled BSDF's diffuse share, with no uniforms, so the camera's G-buffer (common/materials.glsl) and the
-// viewport's fragment shader (viewport/surface.glsl) colour surfaces alike.
+// Principled BSDF's layering, read from the material table (common/principled.py: material_lut) with no other
+// uniforms, so the camera's G-buffer (common/materials.glsl) and the viewport's fragment shader
+// (viewport/surface.glsl) colour surfaces alike. Each material has five rows of texels over μ = n·v ∈ [0, 1]:
+//   row 0: rgb D(μ), the share of the base colour in Cycles' Diffuse Color;  a: E(μ), the GGX lobe's albedo
+//   row 1: rgb the coat's and the dielectric layer's Glossy Color;           a: s5(μ), the lobe-averaged Schlick weight
+//   row 2: rgb the metallic closure's weight;                               a: E_avg
+//   row 3: rgb F0 × tint of the dielectric layer;                           a: its s(μ) (F̄ = mix(F0, 1, s))
+//   row 4: x the layer's η (1: none), y its real F0 (constant over μ)
 #pragma once
 
-// Share of the base colour that Principled BSDF reflects diffusely, 1 − A_spec(roughness, μ = n·v), at IOR 1.5 and
-// Specular IOR Level 0.5: Cycles scales the diffuse closure by (1 − albedo of the specular layer)
-// (kernel/svm/closure.h, closure_layering_weight) and its Diffuse Color pass shows the scaled colour. Values are
-// measured from Cycles 5.2.3's Diffuse Color pass (base 0.8); the μ = 0 row is the grazing limit (Fresnel → 1).
-const float MU_ROWS[7] = float[](0.0, 0.087, 0.259, 0.5, 0.707, 0.866, 1.0);
-const float ROUGH_COLS[6] = float[](0.0, 0.1, 0.25, 0.5, 0.75, 1.0);
-const float DIFFUSE_SHARE[42] = float[](
-    0.0,     0.0,     0.0,     0.0,     0.0,     0.0,
-    0.37972, 0.40365, 0.59258, 0.81089, 0.90123, 0.93673,
-    0.74670, 0.74811, 0.77558, 0.87651, 0.93345, 0.96122,
-    0.91024, 0.91018, 0.91110, 0.93081, 0.95745, 0.97582,
-    0.94950, 0.94944, 0.94898, 0.95284, 0.96740, 0.98179,
-    0.95848, 0.95846, 0.95829, 0.96031, 0.97140, 0.98456,
-    0.96000, 0.96000, 0.96011, 0.96262, 0.97320, 0.98621);
+vec4 principled_row(sampler2D lut, int row, float mu) {
+    vec2 size = vec2(textureSize(lut, 0));
+    float x = clamp(mu, 0.0, 1.0) * (size.x - 1.0) + 0.5;  // texel centres at μ = k/(n−1): linear filtering
+    return texture(lut, vec2(x / size.x, (float(row) + 0.5) / size.y));
+}
 
-float principled_diffuse_share(float mu, float roughness) {
-    mu = clamp(mu, 0.0, 1.0);
-    roughness = clamp(roughness, 0.0, 1.0);
-    int i = 0;
-    while (i < 5 && mu > MU_ROWS[i + 1]) ++i;
-    int j = 0;
-    while (j < 4 && roughness > ROUGH_COLS[j + 1]) ++j;
-    float ti = (mu - MU_ROWS[i]) / (MU_ROWS[i + 1] - MU_ROWS[i]);
-    float tj = (roughness - ROUGH_COLS[j]) / (ROUGH_COLS[j + 1] - ROUGH_COLS[j]);
-    float a = mix(DIFFUSE_SHARE[i * 6 + j], DIFFUSE_SHARE[i * 6 + j + 1], tj);
-    float b = mix(DIFFUSE_SHARE[(i + 1) * 6 + j], DIFFUSE_SHARE[(i + 1) * 6 + j + 1], tj);
-    return mix(a, b, ti);
+vec3 principled_diffuse(sampler2D lut, int material, float mu) {
+    return principled_row(lut, 5 * material, mu).rgb;
+}
+
+// Glossy Color: the dielectric layers' albedo plus the metal's, F82-tint with F0 = the base colour (white tint):
+// weight × (E + F_ms·(1 − E)) × mix(F0, 1, s5), F_ms from F_ss = mix(F0, 1, 1/21) (Kulla–Conty, as Cycles).
+vec3 principled_glossy(sampler2D lut, int material, float mu, vec3 base) {
+    vec4 a = principled_row(lut, 5 * material, mu);
+    vec4 b = principled_row(lut, 5 * material + 1, mu);
+    vec4 c = principled_row(lut, 5 * material + 2, mu);
+    if (max(c.r, max(c.g, c.b)) <= 0.0) return b.rgb;
+    vec3 f0 = clamp(base, 0.0, 1.0);
+    vec3 fss = mix(f0, vec3(1.0), 1.0 / 21.0);
+    vec3 fms = fss * c.a / (vec3(1.0) - fss * (1.0 - c.a));
+    vec3 darkening = vec3(a.a) + fms * (1.0 - a.a);
+    return b.rgb + c.rgb * darkening * mix(f0, vec3(1.0), b.a);
+}
+
+float fresnel_dielectric(float cos_i, float eta) {
+    float c = abs(cos_i);
+    float g2 = eta * eta - 1.0 + c * c;
+    if (g2 <= 0.0) return 1.0;
+    float g = sqrt(g2);
+    float a = (g - c) / (g + c);
+    float b = (c * (g + c) - 1.0) / (c * (g - c) + 1.0);
+    return 0.5 * a * a * (1.0 + b * b);
+}
+
+// Σ over the glossy closures of weight × darkening × F(h·v), for Glossy Direct (direct/ggx.glsl): the metal's
+// F82-tint (white tint: Schlick with F0 = the base colour) and the dielectric layer's F0 × tint blended to 1 by the
+// real dielectric Fresnel, as Cycles' generalised Schlick does; each is its Glossy Color share times F(h·v)/F̄, so
+// averaged over the lobe it gives back Glossy Color. (The coat's share is scaled like the layer's.)
+vec3 principled_glossy_fresnel(sampler2D lut, int material, float mu, vec3 base, float hv) {
+    vec4 a = principled_row(lut, 5 * material, mu);
+    vec4 b = principled_row(lut, 5 * material + 1, mu);
+    vec4 c = principled_row(lut, 5 * material + 2, mu);
+    vec4 d = principled_row(lut, 5 * material + 3, mu);
+    vec4 e = principled_row(lut, 5 * material + 4, mu);
+    vec3 k = vec3(0.0);
+    if (e.x != 1.0) {
+        float s = clamp((fresnel_dielectric(hv, e.x) - e.y) / (1.0 - e.y), 0.0, 1.0);
+        k += b.rgb * mix(d.rgb, vec3(1.0), s) / max(mix(d.rgb, vec3(1.0), d.a), vec3(1e-6));
+    } else {
+        k += b.rgb;  // the coat alone
+    }
+    if (max(c.r, max(c.g, c.b)) > 0.0) {
+        vec3 f0 = clamp(base, 0.0, 1.0);
+        vec3 fss = mix(f0, vec3(1.0), 1.0 / 21.0);
+        vec3 fms = fss * c.a / (vec3(1.0) - fss * (1.0 - c.a));
+        k += c.rgb * (vec3(a.a) + fms * (1.0 - a.a)) * mix(f0, vec3(1.0), pow(1.0 - clamp(hv, 0.0, 1.0), 5.0));
+    }
+    return k;
+}
+
+// E(μ): the GGX lobe's albedo with Fresnel 1 at the material's roughness (Cycles' energy_scale is 1/E).
+float principled_ggx_albedo(sampler2D lut, int material, float mu) {
+    return principled_row(lut, 5 * material, mu).a;
 }

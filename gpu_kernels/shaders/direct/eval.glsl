@@ -86,42 +86,37 @@ float polygon_visibility(GpuLight L, vec3 p, vec3 n, vec3 geo_n) {
     return wsum > 0.0 ? vsum / wsum : 1.0;
 }
 
-vec3 light_irradiance(GpuLight L, vec3 p, vec3 n, vec3 geo_n) {
+// Unshadowed direct irradiance of one light at p (normal n).
+vec3 light_unshadowed(GpuLight L, vec3 p, vec3 n) {
     int type = int(L.color_type.w);
     vec3 color = L.color_type.rgb;
-    bool shadowed = L.params.z > 0.0;
-    if (type == LIGHT_SUN) {
-        vec3 wi = -L.direction.xyz;
-        float cosine = dot(n, wi);
-        if (cosine <= 0.0) return vec3(0.0);
-        float vis = shadowed ? view_visibility(int(L.params.y), p, geo_n, wi) : 1.0;
-        return color * cosine * vis;
-    }
+    if (type == LIGHT_SUN) return color * max(dot(n, -L.direction.xyz), 0.0);
     if (type == LIGHT_POINT || type == LIGHT_SPOT) {
         vec3 d = L.position.xyz - p;
         float d2 = max(dot(d, d), 1e-8);
         vec3 wi = d * inversesqrt(d2);
         float cosine = dot(n, wi);
         if (cosine <= 0.0) return vec3(0.0);
-        float att = 1.0;
-        if (type == LIGHT_SPOT) {
-            // Cycles (kernel/light/spot.h): smoothstep(0, 1, (cos α − cos(half size)) · smooth), smooth = 1/((1−cos half)·blend)
-            att = spot_attenuation(L, -wi);
-            if (att <= 0.0) return vec3(0.0);
-        }
-        float vis = 1.0;
-        if (shadowed) {
-            vis = type == LIGHT_POINT ? cube_visibility(int(L.params.y), p, geo_n)
-                                      : view_visibility(int(L.params.y), p, geo_n, wi);
-        }
+        float att = type == LIGHT_SPOT ? spot_attenuation(L, -wi) : 1.0;
         // position.w = r² for Cycles' soft-falloff disk (E = I·cosθ/(d²+r²)), 0 for a point or sphere light.
-        return color * att * cosine / (d2 + L.position.w) * vis;
+        return color * att * cosine / (d2 + L.position.w);
     }
     // Polygon light: one-sided lights shine along `direction` only.
-    vec3 from_light = p - L.position.xyz;
-    if (L.polygon.z < 0.5 && dot(from_light, L.direction.xyz) <= 0.0) return vec3(0.0);
-    vec3 psa = polygon_light_solid_angle(L, p, n);
-    if (max(psa.r, max(psa.g, psa.b)) <= 0.0) return vec3(0.0);
-    float vis = shadowed ? polygon_visibility(L, p, n, geo_n) : 1.0;
-    return color * psa * vis;
+    if (L.polygon.z < 0.5 && dot(p - L.position.xyz, L.direction.xyz) <= 0.0) return vec3(0.0);
+    return color * polygon_light_solid_angle(L, p, n);
+}
+
+// The light's shadow-map visibility at p (1 for lights that cast no shadow).
+float light_visibility(GpuLight L, vec3 p, vec3 n, vec3 geo_n) {
+    if (L.params.z <= 0.0) return 1.0;
+    int type = int(L.color_type.w);
+    if (type == LIGHT_SUN) return view_visibility(int(L.params.y), p, geo_n, -L.direction.xyz);
+    if (type == LIGHT_POINT) return cube_visibility(int(L.params.y), p, geo_n);
+    if (type == LIGHT_SPOT) return view_visibility(int(L.params.y), p, geo_n, normalize(L.position.xyz - p));
+    return polygon_visibility(L, p, n, geo_n);
+}
+
+vec3 light_irradiance(GpuLight L, vec3 p, vec3 n, vec3 geo_n) {
+    vec3 e = light_unshadowed(L, p, n);
+    return max(e.r, max(e.g, e.b)) > 0.0 ? e * light_visibility(L, p, n, geo_n) : vec3(0.0);
 }

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // G-buffer from the scene camera: world position, shading normal, diffuse colour, emission, geometric normal, glossy
-// colour and roughness (the VCT specular cone, vct/specular.glsl).
+// colour and roughness (the VCT specular cone, vct/specular.glsl), and the glossy lobe's Fresnel (Glossy Direct).
 // Sampled at pixel centres with no MSAA, like Cycles with a ~0.01 px pixel filter (docs/conventions.md).
 #if defined(VERTEX_SHADER)
 #include "common/surface_vertex.glsl"
@@ -22,6 +22,7 @@ layout(location = 2) out vec4 out_albedo;        // rgb Diffuse Color, w = 1
 layout(location = 3) out vec4 out_emission;      // rgb emitted radiance (emission colour × strength)
 layout(location = 4) out vec4 out_geo_normal;    // xyz geometric normal facing the viewer
 layout(location = 5) out vec4 out_glossy;        // rgb Glossy Color, w = Principled roughness
+layout(location = 6) out vec4 out_specular;      // rgb base colour, w = material index (Glossy Direct's Fresnel)
 
 void main() {
     vec3 view_dir = u_camera_ortho ? -u_camera_forward : normalize(u_camera_position - v_position);
@@ -36,7 +37,9 @@ void main() {
     out_normal = vec4(n, dot(v_position - u_camera_position, u_camera_forward));
     out_albedo = vec4(diffuse_albedo(v_uv, dot(n, view_dir)), 1.0);
     out_emission = vec4(u_emission, 1.0);
+    float mu = dot(n, view_dir);
     out_geo_normal = vec4(geo_n, 0.0);
-    out_glossy = vec4(glossy_albedo(v_uv, dot(n, view_dir)), u_roughness);
+    out_glossy = vec4(glossy_albedo(v_uv, mu), u_roughness);
+    out_specular = glossy_inputs(v_uv);
 }
 #endif

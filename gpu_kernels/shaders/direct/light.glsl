@@ -1,16 +1,27 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Direct diffuse light per pixel from the G-buffer: sun, point, spot (Cycles' smoothstep cone), and polygon lights
-// (area lights and emissive triangles) integrated exactly with Lambert's polygon formula, all shadowed through the
-// shadow atlas. Output is Cycles' Diffuse Direct pass: irradiance/π, albedo divided out (docs/conventions.md).
+// Direct light per pixel from the G-buffer: sun, point, spot (Cycles' smoothstep cone), and polygon lights (area
+// lights and emissive triangles), all shadowed through the shadow atlas. Outputs Cycles' Diffuse Direct pass
+// (irradiance/π, polygons integrated exactly with Lambert's formula) and, where the surface has a glossy closure
+// and u_glossy_enabled, its Glossy Direct pass: the GGX reflection of every light toward the camera (direct/ggx.glsl)
+// with Cycles' energy scale 1/E(μ), Glossy Color divided out (docs/conventions.md).
 #include "common/lights.glsl"
 #include "common/light_eval.glsl"
 #include "direct/eval.glsl"
+#include "direct/ggx.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(rgba32f, binding = 0) uniform writeonly image2D u_diffuse_direct;
+layout(rgba32f, binding = 1) uniform writeonly image2D u_glossy_direct;
 uniform sampler2D u_position;      // xyz world position, w hit flag
 uniform sampler2D u_normal;        // xyz shading normal (faces the viewer)
 uniform sampler2D u_geo_normal;    // xyz geometric normal (faces the viewer)
+uniform sampler2D u_glossy;        // rgb Glossy Color, w roughness
+uniform sampler2D u_specular;      // rgb base colour, w material index
+uniform sampler2D u_material_lut;  // common/principled.py: material_lut
+uniform bool u_glossy_enabled;     // a camera G-buffer (the surface atlas has no view direction)
+uniform vec3 u_eye;
+uniform vec3 u_forward;
+uniform bool u_ortho;
 uniform int u_light_count;
 uniform ivec2 u_size;
 
@@ -20,13 +31,27 @@ void main() {
     vec4 pos = texelFetch(u_position, px, 0);
     if (pos.w < 0.5) {
         imageStore(u_diffuse_direct, px, vec4(0.0));
+        imageStore(u_glossy_direct, px, vec4(0.0));
         return;
     }
     vec3 n = normalize(texelFetch(u_normal, px, 0).xyz);
     vec3 geo_n = normalize(texelFetch(u_geo_normal, px, 0).xyz);
-    vec3 irradiance = vec3(0.0);
+    vec4 glossy = u_glossy_enabled ? texelFetch(u_glossy, px, 0) : vec4(0.0);
+    bool has_glossy = max(glossy.r, max(glossy.g, glossy.b)) > 0.0;
+    vec4 spec = texelFetch(u_specular, px, 0);
+    vec3 v = u_ortho ? -u_forward : normalize(u_eye - pos.xyz);
+    GlossyLobe lobe = GlossyLobe(glossy.w * glossy.w, int(spec.w + 0.5), dot(n, v), spec.rgb);
+    vec3 irradiance = vec3(0.0), reflected = vec3(0.0);
     for (int i = 0; i < u_light_count; ++i) {
-        irradiance += light_irradiance(lights[i], pos.xyz, n, geo_n);
+        vec3 e = light_unshadowed(lights[i], pos.xyz, n);
+        vec3 g = has_glossy ? light_glossy(u_material_lut, lobe, lights[i], pos.xyz, n, v) : vec3(0.0);
+        if (max(max(e.r, e.g), max(max(e.b, g.r), max(g.g, g.b))) <= 0.0) continue;
+        float vis = light_visibility(lights[i], pos.xyz, n, geo_n);
+        irradiance += e * vis;
+        reflected += g * vis;
     }
+    float e_mu = max(principled_ggx_albedo(u_material_lut, lobe.material, lobe.mu), 1e-4);
+    vec3 glossy_direct = has_glossy ? reflected / (e_mu * max(glossy.rgb, vec3(1e-6))) : vec3(0.0);
     imageStore(u_diffuse_direct, px, vec4(irradiance / PI, 1.0));
+    imageStore(u_glossy_direct, px, vec4(glossy_direct, 1.0));
 }

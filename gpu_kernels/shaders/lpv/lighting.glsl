@@ -36,12 +36,36 @@ uniform sampler3D u_voxel_normal[MAX_CASCADES];
 uniform vec3 u_fine_origin[MAX_CASCADES];
 uniform ivec3 u_fine_size[MAX_CASCADES];
 
+// The irradiance of voxels within two fine cells of `centre` whose surfaces face along n (within 18°) and lie in
+// this surface's plane (within 0.6 of a fine cell), weighted by distance; −1 if there is none.
+vec3 same_surface_irradiance(int cascade, vec3 p, vec3 n, ivec3 centre) {
+    float h = 0.5 * u_grid_cell[cascade];
+    vec3 sum = vec3(0.0);
+    float wsum = 0.0;
+    for (int dz = -2; dz <= 2; ++dz)
+        for (int dy = -2; dy <= 2; ++dy)
+            for (int dx = -2; dx <= 2; ++dx) {
+                ivec3 G = centre + ivec3(dx, dy, dz);
+                if (any(lessThan(G, ivec3(0))) || any(greaterThanEqual(G, u_fine_size[cascade]))) continue;
+                vec4 front = texelFetch(u_front[cascade], G, 0);
+                if (front.a <= 0.0) continue;
+                vec3 nv = texelFetch(u_voxel_normal[cascade], G, 0).xyz;
+                if (abs(dot(n, nv)) * inversesqrt(max(dot(nv, nv), 1e-20)) < 0.95) continue;
+                vec3 d = u_fine_origin[cascade] + (vec3(G) + 0.5) * h - p;
+                if (abs(dot(d, n)) > 0.6 * h) continue;
+                float w = exp(-dot(d, d) / (h * h));
+                sum += w * (dot(n, nv) >= 0.0 ? front.rgb : texelFetch(u_back[cascade], G, 0).rgb);
+                wsum += w;
+            }
+    return wsum > 0.0 ? sum / wsum : vec3(-1.0);
+}
+
 vec3 flux_irradiance(int cascade, vec3 p, vec3 n) {
     vec3 t = (p - u_fine_origin[cascade]) / (0.5 * u_grid_cell[cascade]) - 0.5;
     ivec3 base = ivec3(floor(t));
     vec3 f = t - vec3(base);
     vec3 sum = vec3(0.0), agreed = vec3(0.0);
-    float wsum = 0.0, agreed_w = 0.0;
+    float wsum = 0.0, agreed_w = 0.0, best = 0.0;
     for (int k = 0; k < 8; ++k) {
         ivec3 o = ivec3(k & 1, (k >> 1) & 1, (k >> 2) & 1);
         ivec3 G = base + o;
@@ -57,14 +81,25 @@ vec3 flux_irradiance(int cascade, vec3 p, vec3 n) {
         float w = (o.x == 1 ? f.x : 1.0 - f.x) * (o.y == 1 ? f.y : 1.0 - f.y) * (o.z == 1 ? f.z : 1.0 - f.z);
         vec3 e = dot(n, nv) >= 0.0 ? front.rgb : texelFetch(u_back[cascade], G, 0).rgb;
         // A voxel whose surfaces face another way (a corner voxel holding a wall and the ceiling has a diagonal
-        // mean normal, and the irradiance of that diagonal) says little about this surface: voxels within ~35° of
-        // the normal count fully, beyond ~45° not at all — unless none is that close.
+        // mean normal, and the irradiance of that diagonal, which sees less of the room) says little about this
+        // surface: its weight falls as cos¹⁶ of the angle between the normals — 0.72 at 11°, 0.16 at 27° (a
+        // corner of two walls of unequal share), 0.004 at 45° — so a voxel of this surface alone wins wherever
+        // there is one; only where none is close do the others speak. (A linear ramp that counted voxels within
+        // 35° fully left a dark line along every junction: the corner voxel's irradiance averaged in.)
         float agree = abs(dot(n, nv)) * inversesqrt(max(dot(nv, nv), 1e-20));
-        float aw = w * clamp((agree - 0.7) / 0.12, 0.0, 1.0);
+        float a2 = agree * agree, a4 = a2 * a2, a8 = a4 * a4;
+        float aw = w * a8 * a8;
+        best = max(best, agree);
         sum += w * e;
         wsum += w;
         agreed += aw * e;
         agreed_w += aw;
+    }
+    // At a junction the eight may hold only corner voxels (both surfaces, a diagonal normal and its lower
+    // irradiance): look a little further along this surface for voxels of it alone.
+    if (best < 0.95) {
+        vec3 near = same_surface_irradiance(cascade, p, n, ivec3(floor(t + 0.5)));
+        if (near.r >= 0.0) return near;
     }
     if (agreed_w > 1e-3) return agreed / agreed_w;
     return wsum > 0.0 ? sum / wsum : vec3(0.0);

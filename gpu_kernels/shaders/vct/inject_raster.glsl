@@ -14,6 +14,11 @@
 // accumulator (vct/inject.glsl resolves the means). So a voxel holding a floor and a wall (an edge) gets the lit
 // wall's radiance on its ±x faces and the floor's on its ±z faces, wherever their surfaces lie in the voxel — the
 // voxel's mean normal could not say which side of such a voxel faces the room.
+// Covered surfaces: a surface with another one in front of it in the same raster column of the same voxel (the
+// floor under a rug lying 1 mm above it, a wall behind a poster) is hidden from that side and leaves the face of
+// that side alone, so the visible surface's colour is the face's. A first pass (MODE_FRONT) keeps, per column,
+// voxel and side of the dominant axis, the front-most surface's depth; only the covered side is left out (the
+// floor's underside still faces down).
 // No float atomics in GL 4.5: the adds are compare-and-swap loops on the float's bits (r32ui).
 #if defined(VERTEX_SHADER)
 layout(location = 0) in vec3 in_position;
@@ -40,6 +45,7 @@ out vec3 g_world;
 out vec2 g_uv;
 flat out vec3 g_normal;        // unit geometric normal
 flat out float g_area;         // surface area (m²) one fragment stands for: (cell/samples)² / |n_dominant|
+flat out int g_axis;           // the dominant axis the triangle is rasterised along
 
 vec3 to_plane(vec3 p, int axis) { return axis == 0 ? p.yzx : (axis == 1 ? p.zxy : p); }
 
@@ -58,6 +64,7 @@ void main() {
         g_uv = v_uv[i];
         g_normal = n;
         g_area = px * px / an[axis];
+        g_axis = axis;
         EmitVertex();
     }
     EndPrimitive();
@@ -73,13 +80,21 @@ uniform float u_grid_cell;
 uniform ivec3 u_grid_size;
 uniform int u_light_count;
 uniform vec3 u_base_color;
-uniform float u_metallic;
+uniform vec3 u_diffuse_mean;      // common/principled.py: diffuse_mean (the layers above the diffuse base)
 uniform bool u_use_texture;
 uniform sampler2D u_base_texture;
 in vec3 g_world;
 in vec2 g_uv;
 flat in vec3 g_normal;
 flat in float g_area;
+flat in int g_axis;
+uniform bool u_cover_test;        // the front-most images are bound (they fit the memory budget, vct/inject.py)
+// Per voxel column (the fragment's pixel) and side: the front-most depth, layer 2k (+axis) and 2k + 1 (−axis) of
+// voxel layer k, in 1/65535 of a cell, larger = further out along that side.
+layout(r32ui, binding = 1) coherent uniform uimage3D u_front_x;
+layout(r32ui, binding = 2) coherent uniform uimage3D u_front_y;
+layout(r32ui, binding = 3) coherent uniform uimage3D u_front_z;
+#define FRONT_TOLERANCE 66u         // 1/1000 of a cell: coplanar pieces (shared edges, duplicates) all count
 // Accumulator: channel c (0–2 Σw·L, 3 Σw, 4–6 Σw·p) of face g of voxel v at (8·v.x + c, v.y, g·nz + v.z).
 layout(r32ui, binding = 0) coherent uniform uimage3D u_acc;
 
@@ -93,12 +108,37 @@ void add_float(ivec3 t, float x) {
     }
 }
 
+ivec3 front_texel(ivec3 v, int s) {
+    return ivec3(ivec2(gl_FragCoord.xy), 2 * v[g_axis] + s);
+}
+
+// How far out along side s (0: +axis, 1: −axis) of its voxel the point lies.
+uint front_depth(vec3 p, ivec3 v, int s) {
+    float f = clamp((p[g_axis] - u_grid_origin[g_axis]) / u_grid_cell - float(v[g_axis]), 0.0, 1.0);
+    return uint((s == 0 ? f : 1.0 - f) * 65535.0 + 0.5);
+}
+
+uint front_load(ivec3 t) {
+    return g_axis == 0 ? imageLoad(u_front_x, t).r : (g_axis == 1 ? imageLoad(u_front_y, t).r : imageLoad(u_front_z, t).r);
+}
+
+void front_max(ivec3 t, uint d) {
+    if (g_axis == 0) imageAtomicMax(u_front_x, t, d);
+    else if (g_axis == 1) imageAtomicMax(u_front_y, t, d);
+    else imageAtomicMax(u_front_z, t, d);
+}
+
 void main() {
     vec3 p = g_world;
     ivec3 v = ivec3(floor((p - u_grid_origin) / u_grid_cell));
     if (any(lessThan(v, ivec3(0))) || any(greaterThanEqual(v, u_grid_size))) return;
+#if defined(MODE_FRONT)
+    front_max(front_texel(v, 0), front_depth(p, v, 0));
+    front_max(front_texel(v, 1), front_depth(p, v, 1));
+    return;
+#endif
     vec3 color = u_use_texture ? textureLod(u_base_texture, g_uv, 0.0).rgb : u_base_color;
-    vec3 albedo = max(color, vec3(0.0)) * (1.0 - clamp(u_metallic, 0.0, 1.0));
+    vec3 albedo = max(color, vec3(0.0)) * u_diffuse_mean;
     for (int side = 0; side < 2; ++side) {
         vec3 n = side == 0 ? g_normal : -g_normal;
         vec3 e = vec3(0.0);
@@ -108,6 +148,10 @@ void main() {
         for (int b = 0; b < 3; ++b) {
             float w = g_area * abs(n[b]);
             if (w <= 0.0) continue;
+            if (u_cover_test && b == g_axis) {
+                int s = n[b] > 0.0 ? 0 : 1;
+                if (front_depth(p, v, s) + FRONT_TOLERANCE < front_load(front_texel(v, s))) continue;  // covered
+            }
             int g = 2 * b + (n[b] > 0.0 ? 0 : 1);
             ivec3 t = ivec3(8 * v.x, v.y, g * u_grid_size.z + v.z);
             add_float(t, w * radiance.r);

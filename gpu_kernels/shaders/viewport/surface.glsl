@@ -46,11 +46,9 @@ void main() {
     // Stay on this triangle's texel centres: the 2×2 footprint never reaches a neighbouring tile.
     vec2 c = clamp(v_tile, v_box.xy + 0.5, v_box.xy + vec2(v_box.z) - 0.5);
     vec2 c_i = clamp(v_tile_i, v_box_i.xy + 0.5, v_box_i.xy + vec2(v_box_i.z) - 0.5);
-    float share = 1.0 - v_mat.x;
-    if (v_mat.z > 0.5) {  // Principled's specular layer: the diffuse share depends on the view (μ = n·v)
-        vec3 n = normalize(v_normal) * (back ? -1.0 : 1.0);
-        share *= principled_diffuse_share(dot(n, normalize(to_eye)), v_mat.y);
-    }
+    // The material's diffuse share at μ = n·v (its rows in u_material_lut, index v_mat.x).
+    vec3 n = normalize(v_normal) * (back ? -1.0 : 1.0);
+    vec3 share = principled_diffuse(u_material_lut, int(v_mat.x + 0.5), dot(n, normalize(to_eye)));
     vec3 direct = share * atlas_lookup(u_direct, c + vec2(0.0, back ? u_forward.w : 0.0));
     vec3 indirect = share * atlas_lookup(u_indirect, c_i + vec2(0.0, back ? u_params.z : 0.0));
     int mode = int(u_params.x + 0.5);
