@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """The example scenes (examples/scenes/): every scene builds, has one camera, light,
-the expected objects and settings; one .blend round-trips; Cycles lights `cornell`.
+the expected objects and settings; the scenes like users' are what the issue asks for;
+one .blend round-trips; Cycles lights `cornell`.
 
 bpy work runs in ONE subprocess (this file run as a script with --collect), so Blender
 state never leaks into the pytest process; it writes a JSON summary that the tests read.
@@ -35,7 +36,19 @@ EXPECTED_COUNTS = {
     "spot_room": (7, 1, 0, 0),
     "courtyard": (6, 1, 0, 0),
     "cornell_animated": (7, 1, 0, 0),
+    "default_principled": (11, 1, 0, 0),
+    "metals": (7, 2, 0, 0),
+    "window_room": (12, 1, 0, 0),
+    "rug_room": (9, 1, 0, 0),
+    "thin_walls": (17, 1, 0, 0),
+    "lamp_room": (15, 0, 0, 1),
+    "many_lights": (7, 20, 0, 0),
+    "outdoor": (23, 1, 0, 0),
+    "product_shot": (5, 2, 0, 0),
+    "furnished": (41, 2, 0, 1),
 }
+SKY_LIT = {"window_room", "thin_walls", "outdoor", "furnished"}  # world strength 1, a constant colour
+COLOURED_LIGHTS = {"many_lights"}  # warm and cool white point lights
 
 
 # --------------------------------------------------------------------------- subprocess side
@@ -63,17 +76,46 @@ def _lights(bpy, objs):
     return lights
 
 
+PRINCIPLED_INPUTS = ("Base Color", "Roughness", "Metallic", "IOR", "Specular IOR Level", "Emission Strength")
+
+
 def _materials(bpy):
-    """(names of emissive materials, node types per material)."""
+    """(names of emissive materials, node types per material, Principled BSDF inputs per material)."""
     emissive = []
-    node_types = {}
+    node_types, principled = {}, {}
     for mat in bpy.data.materials:
         types = sorted({n.bl_idname for n in mat.node_tree.nodes})
         node_types[mat.name] = types
         for n in mat.node_tree.nodes:
             if n.bl_idname == "ShaderNodeEmission" and n.inputs["Strength"].default_value > 0:
                 emissive.append(mat.name)
-    return emissive, node_types
+            if n.bl_idname == "ShaderNodeBsdfPrincipled":
+                v = {k: n.inputs[k].default_value for k in PRINCIPLED_INPUTS}
+                principled[mat.name] = {k: list(x)[:3] if hasattr(x, "__len__") else x for k, x in v.items()}
+                if v["Emission Strength"] > 0:
+                    emissive.append(mat.name)
+    return emissive, node_types, principled
+
+
+def _meshes(objs):
+    """World-space bounding box, triangle count and closedness (every edge between two faces) per mesh object."""
+    import numpy as np
+
+    out = {}
+    for ob in objs:
+        if ob.type != "MESH":
+            continue
+        me = ob.data
+        pts = np.array([tuple(ob.matrix_world @ v.co) for v in me.vertices])
+        edge_faces = {}
+        for p in me.polygons:
+            for key in p.edge_keys:
+                edge_faces[key] = edge_faces.get(key, 0) + 1
+        out[ob.name] = dict(min=pts.min(0).tolist(), max=pts.max(0).tolist(),
+                            triangles=sum(len(p.vertices) - 2 for p in me.polygons),
+                            closed=all(n == 2 for n in edge_faces.values()),
+                            material=me.materials[0].name if me.materials else None)
+    return out
 
 
 def _camera(scene):
@@ -111,7 +153,7 @@ def _summarize(bpy, name):
     scene = bpy.context.scene
     objs = list(bpy.data.objects)
     lights = _lights(bpy, objs)
-    emissive, node_types = _materials(bpy)
+    emissive, node_types, principled = _materials(bpy)
     # Polygon normals of named quads (world space), to check walls face inward.
     normals = {}
     for ob in objs:
@@ -126,6 +168,9 @@ def _summarize(bpy, name):
         resolution=(scene.render.resolution_x, scene.render.resolution_y,
                     scene.render.resolution_percentage),
         world_strength=world_bg.inputs["Strength"].default_value if world_bg else None,
+        world_color_linked=world_bg.inputs["Color"].is_linked if world_bg else None,
+        principled=principled,
+        meshes=_meshes(objs),
         lights=lights,
         emissive=emissive,
         node_types=node_types,
@@ -214,7 +259,7 @@ def test_scene_basics(data, name):
     s = data["scenes"][name]
     assert s["n_cameras"] == 1 and s["camera"]["name"] in s["objects"]
     assert s["resolution"] == [160, 120, 100]
-    assert s["world_strength"] == 0.0
+    assert s["world_strength"] == (1.0 if name in SKY_LIT else 0.0)
     assert s["lights"] or s["emissive"], "scene has no light source"
     types = list(s["objects"].values())
     counts = (types.count("MESH"), types.count("LIGHT"), types.count("EMPTY"), len(s["emissive"]))
@@ -223,7 +268,7 @@ def test_scene_basics(data, name):
         assert "ShaderNodeOutputMaterial" in nodes, mat
         assert {"ShaderNodeBsdfDiffuse", "ShaderNodeBsdfPrincipled", "ShaderNodeEmission"} & set(nodes), (mat, nodes)
     for light in s["lights"].values():
-        assert light["color"] == [1.0, 1.0, 1.0]
+        assert light["color"] == [1.0, 1.0, 1.0] or name in COLOURED_LIGHTS
 
 
 def test_cornell(data):
@@ -321,6 +366,50 @@ def test_gi_rooms(data):
     assert yard["lights"]["Sun"]["energy"] == 5.0
     cam = yard["camera"]["location"]
     assert -3 < cam[0] < 3 and -3 < cam[1] < 3 and 0 < cam[2] < 3
+
+
+def _extent(scene):
+    """The scene's geometry's size along x, y, z (m)."""
+    boxes = scene["meshes"].values()
+    return [max(b["max"][i] for b in boxes) - min(b["min"][i] for b in boxes) for i in range(3)]
+
+
+def test_user_scenes_cover_the_issue(data):
+    """Issue 17's example set: at least 12 scenes like users', each of them what its entry says."""
+    import importlib
+
+    sys.path.insert(0, ROOT)
+    scenes_mod = importlib.import_module("examples.scenes")  # plain Python here: no bpy call
+    user = scenes_mod.USER_SCENES
+    assert len(user) >= 12 and set(user) <= set(data["scenes"])
+    sc = data["scenes"]
+    # Blender's default Principled BSDF on every surface but the vase, which is metallic brass.
+    default = {"Base Color": [0.8, 0.8, 0.8], "Roughness": 0.5, "Metallic": 0.0, "IOR": 1.5, "Specular IOR Level": 0.5,
+               "Emission Strength": 0.0}
+    p = sc["default_principled"]["principled"]
+    for mesh, info in sc["default_principled"]["meshes"].items():
+        inputs = p[info["material"]]
+        if mesh == "Vase":
+            assert inputs["Metallic"] == 1.0 and inputs["Roughness"] == 0.5
+        else:
+            assert {k: pytest.approx(v) for k, v in default.items()} == inputs, mesh
+    assert sum(v["Metallic"] == 1.0 for v in sc["metals"]["principled"].values()) >= 4
+    assert "ShaderNodeTexImage" in sc["textured"]["node_types"]["Checker"]
+    for name in SKY_LIT:
+        assert not sc[name]["world_color_linked"] and any(l["type"] == "SUN" for l in sc[name]["lights"].values())
+    rug = sc["rug_room"]["meshes"]
+    assert rug["Rug"]["min"][2] == pytest.approx(0.001) and rug["Rug"]["max"][2] == pytest.approx(0.001)
+    assert rug["Floor"]["max"][2] == 0.0 and sc["rug_room"]["lights"]["Spot"]["type"] == "SPOT"
+    walls = sc["thin_walls"]["meshes"]
+    partition = [m for name, m in walls.items() if name.startswith("Partition")]
+    assert partition and all(m["max"][0] - m["min"][0] == pytest.approx(0.02) for m in partition)
+    shade = sc["lamp_room"]["meshes"]["LampShade"]
+    assert shade["closed"] and shade["triangles"] == 92 and shade["material"] in sc["lamp_room"]["emissive"]
+    assert not sc["lamp_room"]["lights"]  # the shade is the only light
+    assert sum(l["type"] == "POINT" for l in sc["many_lights"]["lights"].values()) >= 16
+    assert max(_extent(sc["outdoor"])[:2]) >= 100.0
+    assert max(_extent(sc["product_shot"])) <= 0.1 + 1e-6
+    assert sum(t == "MESH" for t in sc["furnished"]["objects"].values()) >= 20
 
 
 def test_cornell_renders_lit(data):
