@@ -53,6 +53,20 @@ class CommittedReference:
         return float(self.meta["noise_floor"].get(name, float("nan")))
 
 
+def build(name: str) -> None:
+    """Build scene `name` (examples.scenes.build) at its reference frame: what the reference was rendered from and
+    what the test renders."""
+    import bpy
+
+    from .. import scenes
+
+    scenes.build(name)
+    frame = FRAMES[name]
+    if frame != bpy.context.scene.frame_current:
+        bpy.context.scene.frame_set(frame)
+        bpy.context.view_layer.update()
+
+
 def paths(name: str, directory: str = DIR) -> tuple[str, str]:
     return os.path.join(directory, f"{name}.npz"), os.path.join(directory, f"{name}.json")
 

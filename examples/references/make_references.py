@@ -40,15 +40,6 @@ from examples import references, scenes  # noqa: E402
 RESOLUTION = scenes.RESOLUTION
 
 
-def build(name: str) -> None:
-    """Build scene `name` at its reference frame (what the test renders too)."""
-    scenes.build(name)
-    frame = references.FRAMES[name]
-    if frame != bpy.context.scene.frame_current:
-        bpy.context.scene.frame_set(frame)
-        bpy.context.view_layer.update()
-
-
 def floors(seeds: list, hit: np.ndarray) -> dict:
     """Half the rel-L1 between the two seeds over `hit`, per pass (as cycles.Reference.noise_floor), and for the
     diffuse light (Direct + Indirect: Cycles counts world light as direct, we may not); None where the pass is 0."""
@@ -74,7 +65,7 @@ def color_unstable(seeds: list, hit: np.ndarray) -> float:
 
 
 def make(name: str, samples: int, out: str, force: bool) -> None:
-    build(name)
+    references.build(name)
     fp = references.fingerprint()
     settings = ReferenceSettings(*RESOLUTION, samples=samples, bounces=references.BOUNCES)
     _, meta_path = references.paths(name, out)
