@@ -12,10 +12,12 @@ fingerprint and settings is skipped unless --force. The Cycles renders are also 
 (~/.cache/bounce-gi or $BOUNCE_GI_CACHE).
 
 Samples: 1024 per pixel and seed (examples.references.SAMPLES), not the 2048 the issue's table used. Timed here
-(2 shared CPU cores), one 2048-spp seed of the slowest scenes took many minutes (see the docstring of SAMPLES'
-users and the JSON's `seconds`); the whole set at 2048 x 2 would have taken well over an hour, so the set is
-rendered at 1024 x 2, and each pass's noise floor (JSON) says what that costs in accuracy. Re-run with
---samples 2048 on a faster machine to halve the noise (the files record what they were rendered with).
+(2 CPU cores shared with other work, 2026-12-02): `furnished` at 2048 spp x 2 seeds took 1005 s (17 min); the
+other eleven at 1024 x 2 took 3757 s (63 min; lamp_room 888 s and many_lights 844 s the slowest, textured 99 s
+the fastest). At 2048 the whole set would have taken about 2.4 hours, so it is rendered at 1024 x 2 (furnished,
+the timing run, kept at 2048); each JSON records its samples and each pass's noise floor, which says what the
+lower count costs (at 1024 spp Combined's floor is 0.002-0.046, Diffuse Indirect's 0.017-0.067). Re-run with
+--samples 2048 --force on a faster machine to lower the floors by about 1/sqrt(2).
 
 Needs bpy; run with the repository root (or its parent, for `bounce_gi`) importable, like the tests.
 """
