@@ -93,9 +93,10 @@ BOUNDS = {
 }
 
 METHODS = ("lpv", "vct")
-# Both methods on all twelve scenes take 7 min here (llvmpipe, 2 cores; LPV 92 s, VCT 320 s of rendering): VCT on
-# its four slowest scenes (173 s) is marked slow and runs with --slow, so the default run (CI) renders LPV on every
-# scene and VCT on eight, about 4 min. The test's run time is printed by `pytest --durations`.
+# Both methods on all twelve scenes took 6 min 56 s here (llvmpipe, 2 cores shared with other work; LPV 92 s and
+# VCT 320 s of rendering), 4 min 36 s when the machine was quieter: VCT on its four slowest scenes (173 s of the
+# 320) is marked slow and runs with --slow. The default run (CI) renders LPV on every scene and VCT on eight:
+# 2 min 52 s here (the slow part alone 1 min 44 s).
 SLOW = {("furnished", "vct"), ("cornell_animated", "vct"), ("lamp_room", "vct"), ("window_room", "vct")}
 
 
