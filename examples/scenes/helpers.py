@@ -229,14 +229,91 @@ def textured_material(name, image):
     return mat
 
 
-def principled_material(name, color, roughness, metallic=0.0):
-    """Material with a single Principled BSDF (IOR 1.5, Specular IOR Level 0.5 — Blender's defaults)."""
+# Blender's default Principled BSDF (a new material's): base colour 0.8, roughness 0.5, IOR 1.5, Specular IOR Level 0.5.
+DEFAULT_BASE = (0.8, 0.8, 0.8)
+DEFAULT_ROUGHNESS = 0.5
+
+
+def principled_material(name, color=DEFAULT_BASE, roughness=DEFAULT_ROUGHNESS, metallic=0.0, specular_level=None,
+                        ior=None, emission=None, emission_strength=0.0, image=None):
+    """Material with a single Principled BSDF; what is not given keeps Blender's default (IOR 1.5, Specular IOR
+    Level 0.5, no emission). `image`: a UV-mapped Image Texture (repeat, linear) drives the base colour."""
     mat = bpy.data.materials.new(name)
     mat.use_nodes = True
-    nodes = mat.node_tree.nodes
-    bsdf = next(n for n in nodes if n.bl_idname == "ShaderNodeBsdfPrincipled")
+    nt = mat.node_tree
+    bsdf = next(n for n in nt.nodes if n.bl_idname == "ShaderNodeBsdfPrincipled")
     bsdf.inputs["Base Color"].default_value = (*color, 1.0)
     bsdf.inputs["Roughness"].default_value = roughness
     bsdf.inputs["Metallic"].default_value = metallic
+    if specular_level is not None:
+        bsdf.inputs["Specular IOR Level"].default_value = specular_level
+    if ior is not None:
+        bsdf.inputs["IOR"].default_value = ior
+    if emission is not None:
+        bsdf.inputs["Emission Color"].default_value = (*emission, 1.0)
+        bsdf.inputs["Emission Strength"].default_value = emission_strength
+    if image is not None:
+        tex = nt.nodes.new("ShaderNodeTexImage")
+        tex.image = image
+        tex.extension = "REPEAT"
+        tex.interpolation = "Linear"
+        uv = nt.nodes.new("ShaderNodeUVMap")
+        uv.uv_map = "UVMap"
+        uv.location, tex.location = (-900, 0), (-650, 0)
+        nt.links.new(uv.outputs["UV"], tex.inputs["Vector"])
+        nt.links.new(tex.outputs["Color"], bsdf.inputs["Base Color"])
     mat.diffuse_color = (*color, 1.0)
     return mat
+
+
+def image_from_array(name, rgb):
+    """Packed 32-bit float image, colourspace Linear Rec.709, from an (H, W, 3) array of linear colours whose row 0
+    is the image's bottom row (Blender's order)."""
+    rgb = np.asarray(rgb, np.float32)
+    h, w = rgb.shape[:2]
+    img = bpy.data.images.new(name, w, h, alpha=False, float_buffer=True)
+    img.colorspace_settings.name = "Linear Rec.709"
+    px = np.ones((h, w, 4), np.float32)
+    px[..., :3] = rgb
+    img.pixels.foreach_set(px.ravel())
+    img.update()
+    img.pack()
+    return img
+
+
+def cylinder(name, radius, depth, location, material, segments=24, caps=True, smooth=False):
+    """A cylinder along Z centred at location; with caps it is closed (24 segments: 48 side and 2 x 22 cap
+    triangles, 92 in all)."""
+    bm = bmesh.new()
+    bm.loops.layers.uv.new("UVMap")
+    bmesh.ops.create_cone(bm, cap_ends=caps, cap_tris=False, segments=segments, radius1=radius, radius2=radius,
+                          depth=depth, calc_uvs=True)
+    me = bpy.data.meshes.new(name)
+    bm.to_mesh(me)
+    bm.free()
+    if smooth:
+        me.shade_smooth()
+    me.materials.append(material)
+    ob = link(bpy.data.objects.new(name, me))
+    ob.location = location
+    return ob
+
+
+def lathe(name, profile, location, material, segments=24):
+    """A smooth surface of revolution about Z from a profile of (radius, z) points, bottom to top (a vase); the
+    bottom is closed by a fan when its radius is > 0."""
+    verts, faces = [], []
+    n = len(profile)
+    for r, z in profile:
+        for k in range(segments):
+            a = 2.0 * math.pi * k / segments
+            verts.append((r * math.cos(a), r * math.sin(a), z))
+    for i in range(n - 1):
+        for k in range(segments):
+            a, b = i * segments + k, i * segments + (k + 1) % segments
+            faces.append((a, b, b + segments, a + segments))
+    if profile[0][0] > 0:
+        faces.append(tuple(reversed(range(segments))))
+    ob = mesh_object(name, verts, faces, material, smooth=True)
+    ob.location = location
+    return ob

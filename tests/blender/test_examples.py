@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """The example scenes (examples/scenes/): every scene builds, has one camera, light,
-the expected objects and settings; one .blend round-trips; Cycles lights `cornell`.
+the expected objects and settings; one .blend round-trips; Cycles lights `cornell`
+(test_user_scenes.py checks the scenes like users' from the same summary).
 
 bpy work runs in ONE subprocess (this file run as a script with --collect), so Blender
 state never leaks into the pytest process; it writes a JSON summary that the tests read.
@@ -8,9 +9,7 @@ state never leaks into the pytest process; it writes a JSON summary that the tes
 import json
 import math
 import os
-import subprocess
 import sys
-import tempfile
 
 import pytest
 
@@ -35,7 +34,19 @@ EXPECTED_COUNTS = {
     "spot_room": (7, 1, 0, 0),
     "courtyard": (6, 1, 0, 0),
     "cornell_animated": (7, 1, 0, 0),
+    "default_principled": (11, 1, 0, 0),
+    "metals": (7, 2, 0, 0),
+    "window_room": (12, 1, 0, 0),
+    "rug_room": (9, 1, 0, 0),
+    "thin_walls": (17, 1, 0, 0),
+    "lamp_room": (15, 0, 0, 1),
+    "many_lights": (7, 20, 0, 0),
+    "outdoor": (23, 1, 0, 0),
+    "product_shot": (5, 2, 0, 0),
+    "furnished": (41, 2, 0, 1),
 }
+SKY_LIT = {"window_room", "thin_walls", "outdoor", "furnished"}  # world strength 1, a constant colour
+COLOURED_LIGHTS = {"many_lights"}  # warm and cool white point lights
 
 
 # --------------------------------------------------------------------------- subprocess side
@@ -63,17 +74,46 @@ def _lights(bpy, objs):
     return lights
 
 
+PRINCIPLED_INPUTS = ("Base Color", "Roughness", "Metallic", "IOR", "Specular IOR Level", "Emission Strength")
+
+
 def _materials(bpy):
-    """(names of emissive materials, node types per material)."""
+    """(names of emissive materials, node types per material, Principled BSDF inputs per material)."""
     emissive = []
-    node_types = {}
+    node_types, principled = {}, {}
     for mat in bpy.data.materials:
         types = sorted({n.bl_idname for n in mat.node_tree.nodes})
         node_types[mat.name] = types
         for n in mat.node_tree.nodes:
             if n.bl_idname == "ShaderNodeEmission" and n.inputs["Strength"].default_value > 0:
                 emissive.append(mat.name)
-    return emissive, node_types
+            if n.bl_idname == "ShaderNodeBsdfPrincipled":
+                v = {k: n.inputs[k].default_value for k in PRINCIPLED_INPUTS}
+                principled[mat.name] = {k: list(x)[:3] if hasattr(x, "__len__") else x for k, x in v.items()}
+                if v["Emission Strength"] > 0:
+                    emissive.append(mat.name)
+    return emissive, node_types, principled
+
+
+def _meshes(objs):
+    """World-space bounding box, triangle count and closedness (every edge between two faces) per mesh object."""
+    import numpy as np
+
+    out = {}
+    for ob in objs:
+        if ob.type != "MESH":
+            continue
+        me = ob.data
+        pts = np.array([tuple(ob.matrix_world @ v.co) for v in me.vertices])
+        edge_faces = {}
+        for p in me.polygons:
+            for key in p.edge_keys:
+                edge_faces[key] = edge_faces.get(key, 0) + 1
+        out[ob.name] = dict(min=pts.min(0).tolist(), max=pts.max(0).tolist(),
+                            triangles=sum(len(p.vertices) - 2 for p in me.polygons),
+                            closed=all(n == 2 for n in edge_faces.values()),
+                            material=me.materials[0].name if me.materials else None)
+    return out
 
 
 def _camera(scene):
@@ -111,7 +151,7 @@ def _summarize(bpy, name):
     scene = bpy.context.scene
     objs = list(bpy.data.objects)
     lights = _lights(bpy, objs)
-    emissive, node_types = _materials(bpy)
+    emissive, node_types, principled = _materials(bpy)
     # Polygon normals of named quads (world space), to check walls face inward.
     normals = {}
     for ob in objs:
@@ -126,6 +166,9 @@ def _summarize(bpy, name):
         resolution=(scene.render.resolution_x, scene.render.resolution_y,
                     scene.render.resolution_percentage),
         world_strength=world_bg.inputs["Strength"].default_value if world_bg else None,
+        world_color_linked=world_bg.inputs["Color"].is_linked if world_bg else None,
+        principled=principled,
+        meshes=_meshes(objs),
         lights=lights,
         emissive=emissive,
         node_types=node_types,
@@ -186,19 +229,9 @@ def _collect(out_path, tmpdir):
 
 
 @pytest.fixture(scope="module")
-def data():
-    import importlib.util
-
-    if importlib.util.find_spec("bpy") is None:
-        pytest.skip("bpy not installed in this interpreter")
-    with tempfile.TemporaryDirectory() as tmp:
-        out = os.path.join(tmp, "summary.json")
-        env = {**os.environ, "BLENDER_USER_RESOURCES": os.path.join(tmp, "blender_user")}
-        proc = subprocess.run([sys.executable, os.path.abspath(__file__), "--collect", out, tmp],
-                              capture_output=True, text=True, timeout=300, cwd=ROOT, env=env)
-        assert proc.returncode == 0, f"exit {proc.returncode}\n{proc.stdout[-4000:]}\n{proc.stderr[-4000:]}"
-        with open(out) as f:
-            return json.load(f)
+def data(examples_summary):
+    """What _collect wrote (tests/blender/conftest.py runs this file with --collect once a session)."""
+    return examples_summary
 
 
 def close(a, b, tol=1e-4):
@@ -214,7 +247,7 @@ def test_scene_basics(data, name):
     s = data["scenes"][name]
     assert s["n_cameras"] == 1 and s["camera"]["name"] in s["objects"]
     assert s["resolution"] == [160, 120, 100]
-    assert s["world_strength"] == 0.0
+    assert s["world_strength"] == (1.0 if name in SKY_LIT else 0.0)
     assert s["lights"] or s["emissive"], "scene has no light source"
     types = list(s["objects"].values())
     counts = (types.count("MESH"), types.count("LIGHT"), types.count("EMPTY"), len(s["emissive"]))
@@ -223,7 +256,7 @@ def test_scene_basics(data, name):
         assert "ShaderNodeOutputMaterial" in nodes, mat
         assert {"ShaderNodeBsdfDiffuse", "ShaderNodeBsdfPrincipled", "ShaderNodeEmission"} & set(nodes), (mat, nodes)
     for light in s["lights"].values():
-        assert light["color"] == [1.0, 1.0, 1.0]
+        assert light["color"] == [1.0, 1.0, 1.0] or name in COLOURED_LIGHTS
 
 
 def test_cornell(data):

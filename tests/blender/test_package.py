@@ -105,7 +105,8 @@ def test_zip_holds_what_the_extension_imports(built_zips):
           sorted(shipped_py - used))
     assert shipped_py == used
     other = files - shipped_py - shaders - {n for n in files if n.startswith("wheels/") and n.endswith(".whl")}
-    assert shaders <= files and other == {"blender_manifest.toml", "LICENSE", "addon/quality_front.json"}, other
+    assert shaders <= files and other == {"blender_manifest.toml", "LICENSE", "addon/quality_front.json",
+                                          "gpu_kernels/common/ggx_tables.npz"}, other
     assert len(used) > 40  # the entry point's imports were found (a wrong root would find one module)
 
 

@@ -1,0 +1,171 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""The example scenes like users' (issue 17) against their committed Cycles references — regression bounds.
+
+Each scene of examples/references (examples.scenes.USER_SCENES) is rendered with both methods' defaults, as
+`bounce-gi render` would, and every pass is compared with the committed two-seed Cycles reference (8 bounces,
+160×120, the samples its JSON says; examples/references/make_references.py renders them with
+addon/reference/cycles.py). Cycles is never rendered here. The work runs in one subprocess,
+tests/support/examples_table.py, which also prints the whole table and the BOUNDS below:
+
+    python tests/support/examples_table.py            # the markdown table and a BOUNDS dict to paste here
+
+BOUNDS, measured with that command (commit and date in the comment above it): rel-L1 per scene × method × pass over the pixels
+that hit geometry in both renders; a bound = measured + 2 × the pass's noise floor + 0.001, rounded up to 3
+decimals. The margin: the noise floor f (half the rel-L1 between the reference's seeds) is the size of the
+reference's own error, so a reference rendered again (other seeds, another Cycles build) moves our rel-L1 by at most
+rel-L1(old, new) ≈ √2·f (triangle inequality; 2f leaves room for f's own spread); 0.001 covers the float16 storage
+(2⁻¹¹ relative) and llvmpipe rounding. Our renderer is deterministic on one driver, so any change of our output
+larger than that fails. Where a measurement meets the issue's target (Combined ≤ 0.08, Diffuse Indirect ≤ 0.15,
+Diffuse Direct ≤ 0.02, Glossy Direct ≤ 0.10) the bound is the target if that is lower. A pass our renderer does not
+write (Glossy Direct, being added) or writes as 0 (LPV's Glossy Indirect) counts as 1.0, and its bound is 1.0
+exactly. "Diffuse Color match" (the share of pixels within 0.01 of Cycles' in every channel, target ≥ 98%) is a
+lower bound: measured − 2 × the share of pixels whose Diffuse Color differs between the seeds − 0.001, or 0.98
+where met. "Diffuse Light" is Diffuse Direct + Indirect (Cycles counts world light as direct, we count it as
+indirect: in the sky-lit scenes only their sum compares).
+
+After a renderer change: run the command, check the table, paste the printed BOUNDS (lower bounds are the point).
+"""
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from support.examples_table import MATCH, TARGETS
+
+ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT))
+from examples import references  # noqa: E402
+
+# Measured by `python tests/support/examples_table.py` at b1c0c78 (main 20ed4d3: no Glossy Direct yet), 2026-12-02,
+# on llvmpipe, against the references committed with it; rounded with the rule in the docstring.
+BOUNDS = {
+    'default_principled': {
+        'lpv': {'Combined': 0.080, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.004, 'Glossy Direct': 1.000, 'Glossy Indirect': 1.000, 'Glossy Color': 0.034, 'Diffuse Light': 0.044, 'Diffuse Color match': 0.997},
+        'vct': {'Combined': 0.054, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.131, 'Diffuse Color': 0.004, 'Glossy Direct': 1.000, 'Glossy Indirect': 0.369, 'Glossy Color': 0.034, 'Diffuse Light': 0.040, 'Diffuse Color match': 0.997},
+    },
+    'metals': {
+        'lpv': {'Combined': 0.193, 'Diffuse Direct': 0.014, 'Diffuse Indirect': 0.507, 'Diffuse Color': 0.004, 'Glossy Direct': 1.000, 'Glossy Indirect': 1.000, 'Glossy Color': 0.030, 'Diffuse Light': 0.054, 'Diffuse Color match': 0.998},
+        'vct': {'Combined': 0.158, 'Diffuse Direct': 0.014, 'Diffuse Indirect': 0.460, 'Diffuse Color': 0.004, 'Glossy Direct': 1.000, 'Glossy Indirect': 0.932, 'Glossy Color': 0.030, 'Diffuse Light': 0.050, 'Diffuse Color match': 0.998},
+    },
+    'textured': {
+        'lpv': {'Combined': 0.018, 'Diffuse Direct': 0.002, 'Diffuse Indirect': 0.135, 'Diffuse Color': 0.002, 'Diffuse Light': 0.019, 'Diffuse Color match': 0.998},
+        'vct': {'Combined': 0.022, 'Diffuse Direct': 0.002, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.002, 'Diffuse Light': 0.021, 'Diffuse Color match': 0.998},
+    },
+    'window_room': {
+        'lpv': {'Combined': 0.625, 'Diffuse Direct': 0.574, 'Diffuse Indirect': 0.847, 'Diffuse Color': 0.004, 'Glossy Direct': 1.000, 'Glossy Indirect': 1.000, 'Glossy Color': 0.053, 'Diffuse Light': 0.491, 'Diffuse Color match': 0.975},
+        'vct': {'Combined': 0.613, 'Diffuse Direct': 0.574, 'Diffuse Indirect': 1.323, 'Diffuse Color': 0.004, 'Glossy Direct': 1.000, 'Glossy Indirect': 1.491, 'Glossy Color': 0.053, 'Diffuse Light': 0.595, 'Diffuse Color match': 0.975},
+    },
+    'rug_room': {
+        'lpv': {'Combined': 0.128, 'Diffuse Direct': 0.003, 'Diffuse Indirect': 0.279, 'Diffuse Color': 0.003, 'Glossy Direct': 1.000, 'Glossy Indirect': 1.000, 'Glossy Color': 0.030, 'Diffuse Light': 0.121, 'Diffuse Color match': 0.998},
+        'vct': {'Combined': 0.146, 'Diffuse Direct': 0.003, 'Diffuse Indirect': 0.375, 'Diffuse Color': 0.003, 'Glossy Direct': 1.000, 'Glossy Indirect': 1.000, 'Glossy Color': 0.030, 'Diffuse Light': 0.162, 'Diffuse Color match': 0.998},
+    },
+    'thin_walls': {
+        'lpv': {'Combined': 6.021, 'Diffuse Direct': 0.985, 'Diffuse Indirect': 10.138, 'Diffuse Color': 0.074, 'Glossy Direct': 1.000, 'Glossy Indirect': 1.000, 'Glossy Color': 3.278, 'Diffuse Light': 6.644, 'Diffuse Color match': 0.262},
+        'vct': {'Combined': 1.598, 'Diffuse Direct': 0.985, 'Diffuse Indirect': 2.641, 'Diffuse Color': 0.074, 'Glossy Direct': 1.000, 'Glossy Indirect': 12.555, 'Glossy Color': 3.278, 'Diffuse Light': 1.524, 'Diffuse Color match': 0.262},
+    },
+    'lamp_room': {
+        'lpv': {'Combined': 0.290, 'Diffuse Direct': 0.549, 'Diffuse Indirect': 0.545, 'Diffuse Color': 0.003, 'Glossy Direct': 1.000, 'Glossy Indirect': 1.000, 'Glossy Color': 0.035, 'Emission': 0.002, 'Diffuse Light': 0.337, 'Diffuse Color match': 0.998},
+        'vct': {'Combined': 1.524, 'Diffuse Direct': 0.549, 'Diffuse Indirect': 2.736, 'Diffuse Color': 0.003, 'Glossy Direct': 1.000, 'Glossy Indirect': 1.453, 'Glossy Color': 0.035, 'Emission': 0.002, 'Diffuse Light': 2.009, 'Diffuse Color match': 0.998},
+    },
+    'many_lights': {
+        'lpv': {'Combined': 0.241, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.228, 'Diffuse Color': 0.005, 'Glossy Direct': 1.000, 'Glossy Indirect': 1.000, 'Glossy Color': 0.059, 'Diffuse Light': 0.156, 'Diffuse Color match': 0.994},
+        'vct': {'Combined': 0.244, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.262, 'Diffuse Color': 0.005, 'Glossy Direct': 1.000, 'Glossy Indirect': 0.927, 'Glossy Color': 0.059, 'Diffuse Light': 0.178, 'Diffuse Color match': 0.994},
+    },
+    'outdoor': {
+        'lpv': {'Combined': 0.325, 'Diffuse Direct': 0.394, 'Diffuse Indirect': 1.754, 'Diffuse Color': 0.013, 'Glossy Direct': 1.000, 'Glossy Indirect': 1.000, 'Glossy Color': 0.382, 'Diffuse Light': 0.261, 'Diffuse Color match': 0.940},
+        'vct': {'Combined': 0.149, 'Diffuse Direct': 0.394, 'Diffuse Indirect': 5.393, 'Diffuse Color': 0.013, 'Glossy Direct': 1.000, 'Glossy Indirect': 1.000, 'Glossy Color': 0.382, 'Diffuse Light': 0.023, 'Diffuse Color match': 0.940},
+    },
+    'product_shot': {
+        'lpv': {'Combined': 0.125, 'Diffuse Direct': 0.041, 'Diffuse Indirect': 0.294, 'Diffuse Color': 0.004, 'Glossy Direct': 1.000, 'Glossy Indirect': 1.000, 'Glossy Color': 0.049, 'Diffuse Light': 0.061, 'Diffuse Color match': 0.989},
+        'vct': {'Combined': 0.121, 'Diffuse Direct': 0.041, 'Diffuse Indirect': 0.293, 'Diffuse Color': 0.004, 'Glossy Direct': 1.000, 'Glossy Indirect': 0.916, 'Glossy Color': 0.049, 'Diffuse Light': 0.061, 'Diffuse Color match': 0.989},
+    },
+    'furnished': {
+        'lpv': {'Combined': 0.193, 'Diffuse Direct': 0.113, 'Diffuse Indirect': 0.287, 'Diffuse Color': 0.013, 'Glossy Direct': 1.000, 'Glossy Indirect': 1.000, 'Glossy Color': 0.187, 'Emission': 0.009, 'Diffuse Light': 0.140, 'Diffuse Color match': 0.974},
+        'vct': {'Combined': 0.128, 'Diffuse Direct': 0.113, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.013, 'Glossy Direct': 1.000, 'Glossy Indirect': 0.928, 'Glossy Color': 0.187, 'Emission': 0.009, 'Diffuse Light': 0.117, 'Diffuse Color match': 0.974},
+    },
+    'cornell_animated': {
+        'lpv': {'Combined': 0.065, 'Diffuse Direct': 0.014, 'Diffuse Indirect': 0.132, 'Diffuse Color': 0.002, 'Diffuse Light': 0.064, 'Diffuse Color match': 0.999},
+        'vct': {'Combined': 0.069, 'Diffuse Direct': 0.014, 'Diffuse Indirect': 0.144, 'Diffuse Color': 0.002, 'Diffuse Light': 0.069, 'Diffuse Color match': 0.999},
+    },
+}
+
+METHODS = ("lpv", "vct")
+# Both methods on all twelve scenes took 6 min 56 s here (llvmpipe, 2 cores shared with other work; LPV 92 s and
+# VCT 320 s of rendering), 4 min 36 s when the machine was quieter: VCT on its four slowest scenes (173 s of the
+# 320) is marked slow and runs with --slow. The default run (CI) renders LPV on every scene and VCT on eight:
+# 2 min 52 s here (the slow part alone 1 min 44 s).
+SLOW = {("furnished", "vct"), ("cornell_animated", "vct"), ("lamp_room", "vct"), ("window_room", "vct")}
+
+
+@pytest.fixture(scope="module")
+def measured(request, tmp_path_factory):
+    """{scene: row} of tests/support/examples_table.py --json for the scene × method pairs this session's selected
+    tests use: one subprocess per method (bpy's global state stays out of pytest)."""
+    wanted = {}
+    for item in request.session.items:
+        params = getattr(getattr(item, "callspec", None), "params", {})
+        if item.module is request.module and "name" in params:
+            wanted.setdefault(params["method"], set()).add(params["name"])
+    env = dict(os.environ, BLENDER_USER_RESOURCES=str(tmp_path_factory.mktemp("blender_user")))
+    rows = {}
+    for method, names in sorted(wanted.items()):
+        proc = subprocess.run([sys.executable, str(ROOT / "tests/support/examples_table.py"), "--json", *sorted(names),
+                               "--methods", method], capture_output=True, text=True, env=env, timeout=1800)
+        line = next((l for l in proc.stdout.splitlines() if l.startswith("RESULT ")), None)
+        assert proc.returncode == 0 and line, f"examples_table failed:\n{proc.stdout[-3000:]}\n{proc.stderr[-3000:]}"
+        for name, row in json.loads(line[len("RESULT "):]).items():
+            rows.setdefault(name, {}).update(row)
+    return rows
+
+
+def test_every_reference_has_bounds():
+    assert set(BOUNDS) == set(references.FRAMES), "BOUNDS and examples/references disagree: re-run examples_table.py"
+    for name, methods in BOUNDS.items():
+        assert set(methods) == set(METHODS), name
+
+
+def test_references_are_the_projects_cycles_settings():
+    """The committed data is what the issue asks for: the project's reference settings (addon/reference/cycles.py),
+    ≥ 1024 spp × seeds 1 and 2, 160×120, 8 bounces, every compared pass, small."""
+    total = 0
+    for name in references.FRAMES:
+        ref = references.load(name)
+        m = ref.meta
+        assert m["scene"] == name and m["frame"] == references.FRAMES[name]
+        assert m["samples"] >= 1024 and m["seeds"] == [1, 2] and m["bounces"] == 8 and m["resolution"] == [160, 120]
+        assert m["cycles"]["filter_width_px"] == 0.01 and not m["cycles"]["adaptive_sampling"]
+        assert set(references.PASSES) | {"Depth"} == set(ref.passes)
+        assert all(ref.passes[p].shape == (120, 160, 3) for p in references.PASSES)
+        assert ref.hit.mean() > 0.3, name  # the camera sees the scene
+        total += sum(os.path.getsize(p) for p in references.paths(name))
+    assert total < 8 * 2 ** 20
+
+
+def _cases():
+    return [pytest.param(name, method, id=f"{name}-{method}",
+                         marks=[pytest.mark.slow] if (name, method) in SLOW else [])
+            for name in references.FRAMES for method in METHODS]
+
+
+@pytest.mark.parametrize("name,method", _cases())
+def test_example_against_cycles(measured, name, method):
+    row = measured[name]
+    assert not row["stale"], row["stale"]
+    got = row[method]
+    print(name, method, {k: v for k, v in got["rel_l1"].items()}, MATCH, got[MATCH], "noise floor",
+          row["noise_floor"])
+    failures = []
+    for key, bound in BOUNDS[name][method].items():
+        if key == MATCH:
+            if not got[MATCH] >= bound:
+                failures.append(f"{MATCH} {got[MATCH]:.4f} < {bound} (seed-unstable {row['diffuse_color_unstable']})")
+            continue
+        value = got["rel_l1"].get(key)
+        if value is None or not value <= bound:
+            target = f", target {TARGETS[key]}" if key in TARGETS else ""
+            failures.append(f"{key} {value} > {bound} (noise floor {row['noise_floor'].get(key)}{target})")
+    assert not failures, f"{name} {method}: " + "; ".join(failures)
+
