@@ -23,9 +23,9 @@ size so the surface does not shadow its own sample. A closed shell's inner sampl
 emitted inwards never reaches the room.
 
 Trapped light. A closed emissive surface (every edge of a connected set of emissive triangles shared by an even
-number of them) whose inside holds no other geometry — a closed lamp shade — emits half its light inwards, and that
-light can only ever light the inside, which no camera outside sees (a shell around the camera, like the white
-furnace's box, traps nothing). Its inner samples are marked `trapped`: the Diffuse Direct pass still lights the
+number of them) — a closed lamp shade, with or without a bulb or the end of the lamp's pole inside — emits half its
+light inwards, and that light can only ever light the inside, which no camera outside sees (a shell around the
+camera, like the white furnace's box or an emissive dome around the scene, traps nothing). Its inner samples are marked `trapped`: the Diffuse Direct pass still lights the
 inside exactly, but the indirect methods leave that light out (VCT's injection sees trapped samples as shadowed, the
 LPV renders no RSM for them), because the voxels would let it out: a thin shell is not opaque at VCT's coarse mip
 levels nor in the LPV's fuzzy occlusion, so the light reflected inside reached the room as well (in
@@ -351,29 +351,14 @@ def inside_closed(shell: np.ndarray, points: np.ndarray) -> np.ndarray:
 
 
 def sealed_shells(scene) -> list[np.ndarray]:
-    """The closed emissive surfaces of `scene` with nothing else inside, as arrays of triangle indices: connected
-    emissive triangles every edge of which is shared an even number of times, no vertex of any other triangle inside
-    them. Something inside — a bulb in the shade, or the whole scene inside an emissive dome — makes one count as
-    open: its inner light is then kept, as for any open emitter."""
+    """The closed emissive surfaces of `scene`, as arrays of triangle indices: connected emissive triangles every
+    edge of which is shared an even number of times. Whatever lies inside one (a bulb, the end of the lamp's pole)
+    is seen only from inside too, so it does not open it; only a camera inside does (shells_around)."""
     idx, _ = emissive_triangles(scene)
     if len(idx) == 0:
         return []
-    tri = scene.positions[idx].astype(np.float64)
-    comp, closed = mesh_components(tri)
-    out = []
-    points = None
-    for c in np.nonzero(closed)[0]:
-        shell = tri[comp == c]
-        lo, hi = shell.reshape(-1, 3).min(0), shell.reshape(-1, 3).max(0)
-        if points is None:
-            points = scene.positions.reshape(-1, 3).astype(np.float64)
-        others = np.ones(scene.triangle_count, bool)
-        others[idx[comp == c]] = False
-        near = points[np.repeat(others, 3)]
-        near = near[np.all((near > lo) & (near < hi), axis=1)]
-        if not any(inside_closed(shell, near[s:s + 256]).any() for s in range(0, len(near), 256)):
-            out.append(idx[comp == c])
-    return out
+    comp, closed = mesh_components(scene.positions[idx].astype(np.float64))
+    return [idx[comp == c] for c in np.nonzero(closed)[0]]
 
 
 def shells_around(scene, shells: list, point) -> tuple:

@@ -8,7 +8,7 @@ import pytest
 
 from bounce_gi.gpu_kernels.common import emitters as em
 from bounce_gi.gpu_kernels.common import lights as lb
-from bounce_gi.gpu_kernels.scene import Material, Scene
+from bounce_gi.gpu_kernels.scene import Camera, Material, Scene
 from bounce_gi.tests.support.synthetic import closed_cylinder
 
 
@@ -141,15 +141,33 @@ def test_a_closed_shade_s_inner_samples_are_trapped_and_its_outer_ones_are_not()
             assert trapped == inward
 
 
-@pytest.mark.parametrize("what", ["open cylinder", "object inside", "camera-sized dome with the scene inside"])
-def test_open_or_occupied_emitters_trap_nothing(what):
+def _camera_at(scene, point):
+    m = np.eye(4)
+    m[:3, 3] = point
+    scene.camera = Camera(m)
+    return scene
+
+
+@pytest.mark.parametrize("what", ["open cylinder", "camera inside the shade", "dome around the scene and camera"])
+def test_open_emitters_and_emitters_around_the_camera_trap_nothing(what):
     if what == "open cylinder":
         scene = scene_of((cylinder(caps=False), lamp()), (floor(), Material("floor")))
-    elif what == "object inside":  # a bulb in the shade: its light and the shade's both stay in (not detected)
-        scene = scene_of((cylinder(), lamp()), (floor(1.5, 0.05), Material("bulb")))
-    else:  # a closed emissive dome around a floor (and so around the camera): its inside is the scene
-        scene = scene_of((cylinder(24, 10.0, 8.0, (0, 0, 1.0)), lamp()), (floor(), Material("floor")))
+    elif what == "camera inside the shade":  # like the white furnace: the inside is what the camera sees
+        scene = _camera_at(scene_of((cylinder(), lamp()), (floor(), Material("floor"))), (0.05, 0.0, 1.5))
+    else:  # a closed emissive dome around a floor and the camera
+        scene = _camera_at(scene_of((cylinder(24, 10.0, 8.0, (0, 0, 1.0)), lamp()), (floor(), Material("floor"))),
+                           (1.0, -2.0, 1.5))
     assert not any(c.sample_trapped.any() for c in em.cluster_emitters(scene, 32, 32))
+
+
+def test_what_lies_inside_a_closed_shade_does_not_open_it():
+    """A bulb in the shade (or the end of the lamp's pole) is lit by the inner light, but seen only from inside too:
+    the shade still traps its inner light for a camera outside — and only the shade's inner samples are trapped."""
+    parts = (cylinder(), lamp()), (floor(1.5, 0.05), Material("bulb")), (floor(), Material("floor"))
+    scene = _camera_at(scene_of(*parts), (2.0, -2.0, 1.5))
+    clusters = em.cluster_emitters(scene, 32, 32)
+    assert sum(int(c.sample_trapped.sum()) for c in clusters) == sum(len(c.sample_points) for c in clusters)
+    assert all(c.sample_trapped[:, 0].sum() + c.sample_trapped[:, 1].sum() == len(c.sample_points) for c in clusters)
 
 
 def test_closedness_needs_every_edge_shared():
