@@ -19,7 +19,8 @@ METHODS = ("none", "lpv", "vct")
 # included (tallied over renders at 16³–48³: VCT 912 B of 3D textures + ≤ 25 B of buffers per voxel of its padded
 # grid; LPV ≤ 1976 B of 3D textures (its geometry volume at twice the resolution included) + 170–320 B of buffers per
 # cell of each cascade, and ≈ 4 MB of VPL buffers at any size). tests/stress/test_grids_bounces.py holds these to a
-# tally of the allocations, so a volume added but not counted here fails a test.
+# tally of the allocations, so a volume added but not counted here fails a test. VCT's injection adds its cover
+# test's front-most images (vct/inject.front_bytes, sized by the grid's largest side).
 VCT_BYTES_PER_VOXEL, VCT_FIXED_BYTES = 940, 2 ** 20
 LPV_BYTES_PER_CELL, LPV_FIXED_BYTES = 2300, 8 * 2 ** 20
 # A triangle is degenerate when twice its area is below this fraction of its longest edge squared: its height is
@@ -66,9 +67,11 @@ def check_renderable(scene: Scene, settings: RenderSettings) -> None:
 def method_bytes(scene: Scene, settings: RenderSettings) -> int:
     """About how many bytes of GPU memory the method's volumes take (0 for "none")."""
     if settings.method == "vct":
+        from .vct.inject import front_bytes
         from .vct.volumes import vct_grid
 
-        return vct_grid(scene, settings.vct).voxel_count * VCT_BYTES_PER_VOXEL + VCT_FIXED_BYTES
+        grid = vct_grid(scene, settings.vct)
+        return grid.voxel_count * VCT_BYTES_PER_VOXEL + front_bytes(grid) + VCT_FIXED_BYTES
     if settings.method == "lpv":
         from .lpv.state import cascade_grids
 

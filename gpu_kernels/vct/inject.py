@@ -75,12 +75,19 @@ def inject(ctx, programs, scene: Scene, geometry, textures: list, vox, shadows, 
     return faces
 
 
+def front_bytes(grid) -> int:
+    """The front-most images' size for `grid` (0 where they would exceed COVER_TEST_BYTES and are not made)."""
+    side = int(max(grid.size)) * INJECT_SAMPLES
+    total = sum(side * side * 2 * int(n) * 4 for n in grid.size)
+    return total if 3 * side * side * 2 * int(max(grid.size)) * 4 <= COVER_TEST_BYTES else 0
+
+
 def front_images(ctx, grid, side: int) -> list:
     """Zeroed r32ui images (side, side, 2·n_axis) for x, y, z: the front-most depth per raster column, voxel layer
     and side (vct/inject_raster.glsl); none when they would exceed COVER_TEST_BYTES."""
     import moderngl
 
-    if 3 * side * side * 2 * int(max(grid.size)) * 4 > COVER_TEST_BYTES:
+    if not front_bytes(grid):
         return []
     out = []
     for n in grid.size:
