@@ -238,7 +238,8 @@ class Pipeline:
         camera = None if scene.camera is None else np.asarray(scene.camera.matrix_world, np.float64)[:3, 3]
         around = em.shells_around(scene, shells, camera)
         trapping = [s for k, s in enumerate(shells) if k not in around]
-        keys["shadow"] = (keys["geometry"], keys["materials"], keys["lights"], repr(settings.shadow), around)
+        keys["shadow"] = (keys["geometry"], keys["materials"], keys["lights"], keys["world"], repr(settings.shadow),
+                         around)
         shadows = cache.run("shadow_maps", keys["shadow"],
                             lambda: sh.render_shadow_atlas(ctx, programs, scene, geometry, settings.shadow,
                                                            trapping))

@@ -9,6 +9,8 @@ Cycles with a ~0.01 px pixel filter (the reference settings in docs/conventions.
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ..scene import Camera
@@ -92,3 +94,13 @@ def look_at(eye, target, up) -> np.ndarray:
     m[0, :3], m[1, :3], m[2, :3] = side, upv, -fwd
     m[:3, 3] = -m[:3, :3] @ eye
     return m
+
+
+def sphere_directions(count: int) -> np.ndarray:
+    """`count` unit vectors spread evenly over the sphere (a spherical Fibonacci lattice: equal-area bands, golden
+    angle in longitude), each standing for a solid angle of 4π/count."""
+    i = np.arange(count) + 0.5
+    z = 1.0 - 2.0 * i / count
+    r = np.sqrt(np.maximum(0.0, 1.0 - z * z))
+    phi = i * math.pi * (3.0 - math.sqrt(5.0))
+    return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=1)

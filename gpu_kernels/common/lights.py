@@ -5,12 +5,17 @@ Units follow Cycles (docs/conventions.md; intern/cycles/scene/light.cpp):
 - sun: `power` is irradiance at normal incidence (W/m²);
 - point/spot: radiant intensity P/(4π) W/sr; a spot is a point light masked by its cone, not concentrated into it;
 - area: one-sided Lambertian emitter of radiance P/(π·A) over its area A;
-- emissive triangles: radiance = material emission (colour × strength), emitted from both sides as in Cycles.
+- emissive triangles: radiance = material emission (colour × strength), emitted from both sides as in Cycles;
+- the world: a constant radiance L from every direction, a light as in Cycles (its light is Diffuse/Glossy Direct).
 Area lights and emissive triangles are "polygon lights", integrated exactly (Lambert's polygon formula) in the shader,
 shadowed by a few sample points on the light, each with a six-view shadow cube (the documented approximation).
 Emissive triangles are grouped into a bounded number of clusters (common/emitters.py), each one polygon light whose
 polygon is a list of triangles with their own radiance, shadowed from its own sample points on both sides of the
 surface: every emissive triangle is shadowed, and the shadow cubes stay within ShadowSettings.emissive_sample_budget.
+The world is one "sky light" shadowed from a fixed set of directions spread evenly over the sphere, one
+orthographic shadow map each (`sky_directions`): its visibility at a point is the cosine-weighted share of those
+directions that reach the sky. The maps hold the scene's real triangles, so a wall of any thickness, one-sided or
+not, keeps the sky out of a closed room and only its openings let it in.
 
 Every numpy dtype here mirrors a GLSL struct in shaders/common/lights.glsl field for field (std430).
 """
@@ -25,7 +30,7 @@ from . import camera as cam
 from . import emitters as em
 from ..scene import Light, Scene
 
-LIGHT_SUN, LIGHT_POINT, LIGHT_SPOT, LIGHT_POLYGON = 0, 1, 2, 3
+LIGHT_SUN, LIGHT_POINT, LIGHT_SPOT, LIGHT_POLYGON, LIGHT_SKY = 0, 1, 2, 3, 4
 
 LIGHT_DTYPE = np.dtype([("color_type", "<f4", 4), ("position", "<f4", 4), ("direction", "<f4", 4),
                         ("params", "<f4", 4), ("polygon", "<f4", 4)])
@@ -48,6 +53,11 @@ class ShadowSettings:
     # shadowed from 1–4 sample points on each of its two sides.
     emissive_sample_budget: int = 64
     pcf_radius: int = 1  # PCF kernel (2r+1)²
+    # The world's light: shadow directions over the whole sphere (0: the world lights unshadowed) and texels per
+    # side of each one's map. Many small maps rather than a few large ones: the error of the sky's visibility is
+    # that of a quadrature over directions (an opening seen through few of them bands), not of the texel size.
+    sky_directions: int = 384
+    sky_resolution: int = 192
 
 
 @dataclass
@@ -65,6 +75,7 @@ class ShadowView:
     # sealed inside of a closed emitter (its light is trapped there: common/emitters.py); zero for other lights.
     emit_normal: np.ndarray | None = None
     emit_share: float = 0.0
+    pcf_radius: int | None = None  # this view's PCF radius, where not ShadowSettings.pcf_radius (the sky's: 0)
 
 
 @dataclass
@@ -160,8 +171,14 @@ def cube_views(origin, resolution: int, near: float, far: float, emit_normal=Non
 
 def sun_view(scene: Scene, light: Light, resolution: int) -> ShadowView:
     """Orthographic view along the sun direction, fitted to the scene's bounding sphere."""
+    return ortho_view(scene, light.direction, resolution)
+
+
+def ortho_view(scene: Scene, d, resolution: int) -> ShadowView:
+    """Orthographic view looking along unit direction d (where the light travels), fitted to the scene's bounding
+    sphere."""
     centre, radius = _scene_radius(scene)
-    d = light.direction
+    d = np.asarray(d, np.float64)
     eye = centre - d * radius * 2
     up = np.array([0, 0, 1.0]) if abs(d[2]) < 0.99 else np.array([0, 1.0, 0])
     view = cam.look_at(eye, centre, up)
@@ -231,7 +248,28 @@ def build_light_buffers(scene: Scene, settings: ShadowSettings | None = None, tr
             continue
         _add_lamp(out, scene, light, s)
     _add_emissive(out, scene, s, trapping)
+    _add_sky(out, scene, s)
     return out.finish()
+
+
+def _add_sky(out: _Records, scene: Scene, s: ShadowSettings) -> None:
+    """The world as one light of radiance L (its colour × strength) from every direction, shadowed from
+    `sky_directions` directions d_k, each an orthographic map looking along −d_k whose ShadowView.emitter holds
+    (d_k, its solid angle 4π/K): direct/eval.glsl weighs their visibility by cosine (diffuse) or by the glossy
+    lobe, lpv/inject.glsl lights each map's texels with L·(4π/K)."""
+    radiance = np.asarray(scene.world.color, np.float64)[:3]
+    if max(radiance) <= 0 or not len(scene.positions):
+        return
+    dirs = cam.sphere_directions(s.sky_directions) if s.sky_directions > 0 else np.zeros((0, 3))
+    share = 4 * math.pi / max(len(dirs), 1)
+    v = []
+    for d in dirs:
+        view = ortho_view(scene, -d, s.sky_resolution)
+        # Hard shadows: the directions' average is the penumbra (filtering each map would only blur where the
+        # next direction's edge lies).
+        view.emit_normal, view.emit_share, view.pcf_radius = d, share, 0
+        v.append(view)
+    out.add(LIGHT_SKY, radiance, light_views=v, samples=len(v), per=1)
 
 
 def unreachable(scene: Scene, light: Light) -> str:
@@ -323,7 +361,8 @@ def pack_views(views: list[ShadowView], tiles: list[tuple], atlas_size: tuple[in
         out[i]["origin"] = (*v.origin, 1.0 if v.ortho else 0.0)
         # The atlas may have shrunk the tile: a texel then covers resolution/w times more ground.
         light = view_lights[i] if view_lights is not None else 0
-        out[i]["info"] = (v.texel_world * v.resolution / w, pcf_radius, v.far, light)
+        out[i]["info"] = (v.texel_world * v.resolution / w, pcf_radius if v.pcf_radius is None else v.pcf_radius,
+                          v.far, light)
         if v.emit_normal is not None:
             out[i]["emitter"] = (*v.emit_normal, v.emit_share)
     return out

@@ -4,7 +4,7 @@
 absorbed light → irradiance. Every scale is derived, none tuned (see the shaders' comments):
 
 - RSM texel → VPL flux Φ = albedo × irradiance × texel area (lpv/inject.glsl), so injection is independent of
-  the RSM resolution; world light enters through the grid's open border (lpv/sky.glsl);
+  the RSM resolution; world light is the sky light's RSMs (common/lights.py), like any light's;
 - a VPL is the Lambertian intensity (Φ/π)·max(0, n·ω) on 2-band SH, in the cell half a cell in front of it;
 - propagation conserves flux exactly in empty space (far face 0.4006696846 sr + 4 side faces 0.4234313544 sr
   = 2π/3 per neighbour); negative lobes propagate as they are unless `clamp_negative` (which adds energy);
@@ -15,7 +15,7 @@ absorbed light → irradiance. Every scale is derived, none tuned (see the shade
 - transport (default "transfer", lpv/transfer.py): every surface voxel gathers the light of clusters of surface
   voxels directly, with fuzzy visibility, through a kernel cached per geometry (light, material and world edits
   re-run no visibility); "gather" (lpv/gather.py) re-makes its VPL lists every bounce; "propagate" is the classic
-  LPV above — the face scheme turns light sideways within a few cells. World light propagates in all three.
+  LPV above — the face scheme turns light sideways within a few cells. World light bounces in all three.
 
 Iterations stop adaptively once a step moves less than `epsilon` of the injected flux.
 """

@@ -12,7 +12,7 @@ irradiance that the flux lookup reads and the next bounce reflects) and replaces
 
 - first bounce: the RSM texels, clustered k×k into at most `gather_vpls` VPLs (`vpl_list`);
 - each further bounce: the light the surface voxels reflect, clustered into S×S×S blocks (`bounce_vpls`);
-- world light still enters through the open border and propagates (lpv/sky.glsl).
+- world light is the sky light's VPLs, gathered like any other light's.
 
 Cost: voxels × VPLs × (distance / cell) samples per bounce — independent of the propagation's iteration count.
 """
@@ -204,17 +204,12 @@ def gather(ctx, programs, state: LpvGridState, gv, vpls: VplList, occlusion: boo
 
 
 def gather_all(ctx, programs, states: list, gvs: list, settings: LpvSettings) -> dict:
-    """The gathered transport, per cascade: world light propagates and is absorbed as in
-    `propagate_all`; the RSM's VPLs (state.vpls) and then, bounce by bounce, the light the surface voxels reflect
-    are gathered straight to the surface voxels."""
+    """The gathered transport, per cascade: the RSM's VPLs (state.vpls, the sky light's among them) and then,
+    bounce by bounce, the light the surface voxels reflect are gathered straight to the surface voxels."""
     stats = []
     for state, gv in zip(states, gvs):
         state.face_flux.clear()
-        iterations = 0
-        if state.injected_flux > 0:  # world light: the only light injected for this transport
-            iterations = propagate(ctx, programs, state, state.injected, state.injected_flux, gv.blocking, settings,
-                                   accumulate=False)["iterations"]
-        absorb(ctx, programs, state, gv, add=False)  # the world light's irradiance (zeros without it)
+        absorb(ctx, programs, state, gv, add=False)  # zeros: the irradiance textures the gathers add to
         bounces = []
         gathered = min(settings.bounces, settings.gathered_bounces or settings.bounces)
         vpls = state.vpls
@@ -234,6 +229,5 @@ def gather_all(ctx, programs, states: list, gvs: list, settings: LpvSettings) ->
                 extrapolate_tail(ctx, programs, state, gv, tail_sum(ratio, n))
                 bounces.append({"extrapolated": n, "ratio": [float(r) for r in ratio]})
         stats.append({"cells": list(state.grid.size), "cell": state.grid.cell,
-                      "injected_flux": state.injected_flux + state.vpls.flux, "world_flux": state.injected_flux,
-                      "bounces": bounces, "iterations": iterations})
+                      "injected_flux": state.vpls.flux, "bounces": bounces})
     return {"cascades": stats}

@@ -3,7 +3,7 @@
 
     rsm              ← shadow views, RSM resolution
     geometry_volume  ← geometry, materials, grids
-    lpv_inject       ← rsm, grids, geometry volume, world
+    lpv_inject       ← rsm, grids
     lpv_propagate    ← injection, geometry volume, LPV settings (the transport: gather.gather_all or
                        propagate.propagate_all; with octree levels, octree.py's passes)
     lpv_lighting     ← gbuffer, transport
@@ -15,7 +15,6 @@ alone and the passes are instead:
     lpv_albedo           ← geometry volume, materials          (the surface voxels' albedo)
     lpv_transfer         ← geometry volume, budget             (clusters and the kernel T: the expensive part)
     lpv_transfer_albedo  ← transfer, albedo                    (M_ρ: cluster-to-cluster reflection)
-    lpv_world            ← geometry volume, settings           (a unit world, propagated and absorbed: × colour)
     lpv_inject           ← rsm, transfer                       (the RSM's flux per cluster)
     lpv_propagate        ← all of the above, bounces           (the bounce series and one product with T)
     lpv_lighting         ← gbuffer, transport
@@ -25,14 +24,13 @@ from __future__ import annotations
 import numpy as np
 
 from ..common.method import MethodOutput
-from ..scene import hash_parts
 from ..voxel.voxelize import scene_area
 from . import clusters, gather, inject, lighting, occlusion, octree, propagate, rsm, transfer
 from .state import LpvGridState, cascade_grids
 
 # Outputs kept per pass (gl/pass_cache.py): the geometry's passes for two settings (the live viewport's draft and
 # final stages use two grids; each would otherwise rebuild its transfer on every edit).
-KEEP = {name: 2 for name in ("geometry_volume", "lpv_albedo", "lpv_transfer", "lpv_transfer_albedo", "lpv_world")}
+KEEP = {name: 2 for name in ("geometry_volume", "lpv_albedo", "lpv_transfer", "lpv_transfer_albedo")}
 
 
 def run(frame) -> MethodOutput:
@@ -50,9 +48,9 @@ def run(frame) -> MethodOutput:
     gvs = cache.run("geometry_volume", k_gv, lambda: occlusion.geometry_volumes(
         ctx, programs, scene, frame.geometry, frame.textures, grids) if s.occlusion else [None] * len(grids))
     gather_vpls = s.gather_vpls if s.gathers else 0
-    k_inject = (k_rsm, k_grids, k_gv, hash_parts(scene.world), s.rsm_downsample, gather_vpls)
+    k_inject = (k_rsm, k_grids, s.rsm_downsample, gather_vpls)
     states = cache.run("lpv_inject", k_inject, lambda: inject.inject_all(
-        ctx, programs, maps, frame.shadows, grids, scene.world.color, gvs, s.rsm_downsample, gather_vpls))
+        ctx, programs, maps, frame.shadows, grids, s.rsm_downsample, gather_vpls))
     k_prop = (k_inject, k_gv, repr(s))
     if s.octree_levels:
         states, gvs, stats, s = _octree(frame, states, gvs, grids, k_gv, k_inject, k_prop)
@@ -121,21 +119,12 @@ def transfer_bytes(scene, s) -> tuple[int, int]:
 def _transfer(frame, grids, k_grids, maps, k_rsm, budget) -> MethodOutput:
     """The cached transport's passes (lpv/transfer.py); see the module docstring for what each reads."""
     ctx, programs, cache, scene, s = frame.ctx, frame.programs, frame.cache, frame.scene, frame.settings.lpv
-    gvs, transfers, weights, m_rho, keys = _transfer_geometry(frame, grids, k_grids, budget)
-    world = tuple(float(c) for c in scene.world.color[:3])
-    worlds = [None] * len(gvs)  # a black world: nothing to propagate (a sky it lit before stays cached)
-    if max(world) > 0:
-        k_sky = (keys["gv"], s.max_iterations, s.epsilon, s.clamp_negative)
-        skies = cache.run("lpv_world", k_sky, lambda: [_sky(ctx, programs, gv, grid, s)
-                                                       for gv, grid in zip(gvs, grids)])
-        worlds = [sky[..., None] * np.asarray(world) for sky in skies]
+    gvs, transfers, _, m_rho, keys = _transfer_geometry(frame, grids, k_grids, budget)
     k_src = (k_rsm, keys["transfer"])
     sources = cache.run("lpv_inject", k_src, lambda: [clusters.bin_flux(t.clusters, gather.rsm_records(
         ctx, programs, maps, frame.shadows, grid, budget)[0]) for t, grid in zip(transfers, grids)])
-    k_prop = (k_src, keys["albedo_transfer"], keys["gv"], world, s.max_iterations, s.clamp_negative, s.bounces,
-              s.epsilon)
-    solved = cache.run("lpv_propagate", k_prop, lambda: _solve(ctx, gvs, grids, transfers, m_rho, weights, worlds,
-                                                               sources, s))
+    k_prop = (k_src, keys["albedo_transfer"], keys["gv"], s.max_iterations, s.clamp_negative, s.bounces, s.epsilon)
+    solved = cache.run("lpv_propagate", k_prop, lambda: _solve(ctx, gvs, grids, transfers, m_rho, sources, s))
     k_light = (frame.keys["gbuffer"], k_prop)
     indirect = cache.run("lpv_lighting", k_light,
                          lambda: lighting.lighting(ctx, programs, frame.gbuffer, solved["surfaces"], gvs, s))
@@ -176,8 +165,6 @@ def skipped_work(stats: list, s) -> list:
     """What the scene let the cached transport leave out, in words (render --json "skipped_work", the panel)."""
     out = []
     for c in stats[:1]:  # the cascades skip alike
-        if not c["world"]:
-            out.append("world light: the world is black, nothing propagates")
         if c["injected_flux"] == 0:
             out.append("first bounce: no light reaches a surface the transport sees (no lights, or all off)")
         if c["bounces_used"] < s.bounces:
@@ -200,32 +187,16 @@ def _build(ctx, programs, gv, grid, budget, s, prior=None) -> transfer.Transfer:
     return transfer.sort_by_cluster(sources, matrix, gv, grid)
 
 
-def _sky(ctx, programs, gv, grid, s) -> np.ndarray:
-    """The irradiance a world of unit radiance gives each surface voxel, (2, R) per side: propagated in from the
-    open border and absorbed as in gather.gather_all. Linear in the world's radiance (the propagation is, and its
-    stopping test is relative), so a world edit multiplies this by the new colour and propagates nothing."""
-    state = LpvGridState(ctx, grid)
-    try:
-        state.injected_flux = inject.inject(ctx, programs, None, None, state, (1.0, 1.0, 1.0), gv, vpls=False)
-        state.face_flux.clear()
-        propagate.propagate(ctx, programs, state, state.injected, state.injected_flux, gv.blocking, s,
-                            accumulate=False)
-        occlusion.absorb(ctx, programs, state, gv, add=False)
-        return transfer.read_sides(state, gv.cells)[..., 0]
-    finally:
-        state.release()
-
-
-def _solve(ctx, gvs, grids, transfers, m_rho, weights, worlds, sources, s) -> dict:
+def _solve(ctx, gvs, grids, transfers, m_rho, sources, s) -> dict:
     """Each cascade's bounce series (transfer.solve), uploaded for the flux lookup, and its statistics."""
     surfaces, stats = [], []
-    for gv, grid, t, m, w, world, (first, unbinned) in zip(gvs, grids, transfers, m_rho, weights, worlds, sources):
-        sides, passes = transfer.solve(t, m, w, first, world, s.bounces, s.epsilon)
+    for gv, grid, t, m, (first, unbinned) in zip(gvs, grids, transfers, m_rho, sources):
+        sides, passes = transfer.solve(t, m, first, s.bounces, s.epsilon)
         valid = (gv.surface_area > 0) & (np.linalg.norm(gv.surface_normal, axis=1) > 0)
         surfaces.append(transfer.upload_sides(ctx, grid, gv.fine, gv.cells, valid, sides))
         stats.append({"cells": list(grid.size), "cell": grid.cell, "transport": "transfer",
                       "clusters": t.clusters.count, "block": t.clusters.block, "transfer_mb": t.nbytes / 2 ** 20,
                       "transfer_updated": t.updated, "injected_flux": float(first.sum()),
-                      "escaped_flux": unbinned, "world": world is not None,
+                      "escaped_flux": unbinned,
                       "bounces": [{"flux": f} for f in passes], "bounces_used": len(passes)})
     return {"surfaces": surfaces, "stats": stats}

@@ -1,7 +1,6 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """The classic LPV transport (LpvSettings.transport = "propagate"): the Kaplanyan–Dachsbacher face scheme with
-fuzzy occlusion, bounce by bounce, until a step moves less than ε of the injected flux. World light propagates
-this way under either transport."""
+fuzzy occlusion, bounce by bounce, until a step moves less than ε of the injected flux."""
 from __future__ import annotations
 
 import numpy as np

@@ -42,10 +42,10 @@ def flux_bound(buffers: lb.LightBuffers) -> float:
     for i, rec in enumerate(buffers.lights):
         color = float(np.max(rec["color_type"][:3]))
         kind = int(rec["color_type"][3])
-        if kind == lb.LIGHT_SUN:
+        if kind in (lb.LIGHT_SUN, lb.LIGHT_SKY):  # each view's square × its irradiance (a sky view's: L·Ω_k)
             views = [v for v, l in zip(buffers.views, buffers.view_lights) if l == i]
-            half = views[0].half_extent if views else 1.0
-            total += color * (2 * half) ** 2
+            total += sum(color * (v.emit_share if kind == lb.LIGHT_SKY else 1.0) * (2 * v.half_extent) ** 2
+                         for v in views)
         elif kind in (lb.LIGHT_POINT, lb.LIGHT_SPOT):
             total += color * 4 * math.pi
         else:

@@ -29,7 +29,7 @@ class LpvSettings:
     octree_iterations: int = 4  # propagation steps on every octree level (Olovsson and Doggett 2013, §4: k = 4)
     # Transport: "gather" sends light straight from VPLs to every surface voxel with fuzzy visibility, bounce by
     # bounce (lpv/gather.py: the face scheme turns light sideways within a few cells); "propagate" is the classic
-    # LPV. World light propagates either way. The gather writes surface voxels' irradiance, which only the flux
+    # LPV. World light bounces either way (the sky light's RSMs). The gather writes surface voxels' irradiance, which only the flux
     # lookup with occlusion reads: the intensity lookup, occlusion=False and the octree always propagate (see
     # `gathers`). `gather_vpls` bounds the VPLs per bounce: RSM texels and surface voxels are clustered to fit.
     # "transfer" is the gather with its sources fixed per geometry and the kernel cached (lpv/transfer.py): an

@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """The LPV's cached transport (LpvSettings.transport = "transfer", the default): the gathered transport of
-lpv/gather.py with its geometry-dependent part kept across light, material and world edits.
+lpv/gather.py with its geometry-dependent part kept across light, material and world edits (the world is a light:
+common/lights.py's sky light, whose RSMs give its first bounce like any other light's).
 
 For fixed geometry the gather is linear in the light that enters it. Its sources are fixed here: the surface voxels'
 sides grouped, once per geometry, into clusters (lpv/clusters.py). The kernel of
@@ -9,9 +10,8 @@ receiver voxel and cluster on the GPU (MODE_TRANSFER) and read back: the transfe
 edit of the lights or the world costs only:
 
     Φ_1        the RSM's VPL flux binned into the clusters (flux kept exactly)
-    E_world    the world's colour × the response to a unit world (propagated and absorbed once per geometry)
-    Φ_2        = reflect(E_world) + M_ρ Φ_1,   Φ_(k+1) = M_ρ Φ_k      (C × C per channel: microseconds)
-    E_total    = E_world + T · (Φ_1 + Φ_2 + … + Φ_N)                 (one product with T)
+    Φ_(k+1)    = M_ρ Φ_k                                              (C × C per channel: microseconds)
+    E_total    = T · (Φ_1 + Φ_2 + … + Φ_N)                            (one product with T)
 
 where reflect(E) sums albedo × area × E over each cluster's voxel sides, and M_ρ = reflect ∘ T, the cluster-to-
 cluster transfer with the receivers' albedo (re-built on a material edit, which re-voxelises only the albedo:
@@ -158,6 +158,8 @@ class Transfer:
     normals: np.ndarray = None
     areas: np.ndarray = None
     updated: float = 1.0  # the share of T evaluated when it was made (1: all of it; less after an edit)
+    gain: np.ndarray | None = None  # (C,) what each cluster's flux is scaled by before T: conserving_gain
+
 
     @property
     def nbytes(self) -> int:
@@ -178,8 +180,21 @@ def sort_by_cluster(clusters: Clusters, matrix: np.ndarray, gv=None, grid: Grid 
         starts.append(np.searchsorted(key[perm], np.arange(clusters.count + 1)))
     if gv is None:
         return Transfer(clusters, out, order, starts, updated=updated)
+    gain = conserving_gain(matrix, gv.surface_area)
     return Transfer(clusters, out, order, starts, grid, gv.cells.copy(), gv.surface_normal.copy(),
-                    gv.surface_area.copy(), updated)
+                    gv.surface_area.copy(), updated, gain)
+
+
+def conserving_gain(matrix: np.ndarray, areas: np.ndarray) -> np.ndarray:
+    """(C,) ≤ 1: the factor that keeps what one watt of cluster c delivers to all receivers together,
+    P_c = Σ_sides Σ_r T[side, c, r]·area_r, at most one watt. P_c ≤ 1 holds for the exact kernel (light leaving
+    a surface lands once, or leaves the scene); the voxel kernel breaks it where a slab thinner than a voxel puts
+    its two faces' voxels within END_CELLS of each other (lpv/gather.glsl: the crossing at a receiver's own end is
+    not counted), so the back side of the far face's voxel — inside the slab — receives the light its near face
+    did, and reflects it again: each bounce then grows (P_c up to 2.5 behind 2 cm walls), the series diverges.
+    Scaling such a cluster's flux to deliver one watt bounds every bounce by the albedo."""
+    delivered = sum(matrix[side].astype(np.float64) @ np.asarray(areas, np.float64) for side in range(2))
+    return np.where(delivered > 1.0, 1.0 / np.maximum(delivered, 1e-30), 1.0)
 
 
 def albedo_transfer(t: Transfer, weight: np.ndarray) -> np.ndarray:
@@ -198,31 +213,28 @@ def albedo_transfer(t: Transfer, weight: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(out.transpose(2, 0, 1), np.float64)
 
 
-def solve(t: Transfer, m_rho: np.ndarray, weight: np.ndarray, first: np.ndarray, world: np.ndarray | None,
-          bounces: int, epsilon: float) -> tuple[np.ndarray, list]:
-    """Irradiance summed over `bounces` passes, (2, R, 3) per side: the world's own (`world`, (2, R, 3) or None)
-    plus T × the sources' flux summed over passes — `first` (C, 3) from the RSM, each further pass's the
-    reflection of the one before (M_ρ). Stops once a pass's flux is below `epsilon` of the largest so far.
-    Returns the totals and, per pass, its source flux."""
+def solve(t: Transfer, m_rho: np.ndarray, first: np.ndarray, bounces: int, epsilon: float
+          ) -> tuple[np.ndarray, list]:
+    """Irradiance summed over `bounces` passes, (2, R, 3) per side: T × the sources' flux summed over passes —
+    `first` (C, 3) from the RSM, each further pass's the reflection of the one before (M_ρ), every pass's flux
+    scaled by t.gain (conserving_gain) where T carries it. Stops once a pass's flux is below `epsilon` of the
+    largest so far. Returns the totals and, per pass, its source flux."""
+    gain = 1.0 if t.gain is None else t.gain[:, None]  # conserving_gain: the flux T and M_ρ carry
     phi = np.asarray(first, np.float64)
     total = phi.copy()
     passes = [float(phi.sum())]
-    following = np.einsum("kij,jk->ik", m_rho, phi)
-    if world is not None:
-        following += reflect(t.clusters, weight, world)
+    following = np.einsum("kij,jk->ik", m_rho, phi * gain)
     for _ in range(2, bounces + 1):
         phi = following
         passes.append(float(phi.sum()))
         total += phi
         if passes[-1] <= epsilon * max(passes):
             break
-        following = np.einsum("kij,jk->ik", m_rho, phi)
-    sums = total.T.astype(np.float32)  # (3, C)
+        following = np.einsum("kij,jk->ik", m_rho, phi * gain)
+    sums = (total * gain).T.astype(np.float32)  # (3, C)
     out = np.empty((2, t.matrix.shape[2], 3), np.float32)
     for side in range(2):
         out[side, t.order[side]] = (sums @ t.matrix[side]).T
-    if world is not None:
-        out += world
     return out, passes
 
 

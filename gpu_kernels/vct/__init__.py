@@ -19,7 +19,8 @@ Passes (vct/passes.py runs them through the pass cache):
   vct_specular  one glossy cone per pixel → Glossy Indirect (vct/specular.py).
 
 Every scale is derived; the shaders' comments give the derivations (self-occlusion bound, step opacity, anisotropic
-optical depth, the layer test, sub-rays), `cone_table` and `subray_radius` give the cones'. Sky light: the world
-colour fills what is left of every cone that leaves the grid; it lands in Diffuse Indirect here, whereas Cycles
-counts world light as Diffuse Direct.
+optical depth, the layer test, sub-rays), `cone_table` and `subray_radius` give the cones'. The world is a light
+(common/lights.py: the sky light, shadowed by the real triangles): its direct light is Diffuse/Glossy Direct as in
+Cycles, its bounce enters the voxels through their injection like any light's, and no cone adds the world it
+reaches — a voxel's partial opacity would let the sky through walls thinner than a voxel.
 """

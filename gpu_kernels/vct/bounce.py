@@ -16,7 +16,7 @@ from .trace import bind_cones
 from .volumes import ConeVolumes, Faces, bind_volumes
 
 
-def bounce(ctx, programs, vox, direct_faces: Faces, volumes: ConeVolumes, s: VctSettings, world) -> ConeVolumes:
+def bounce(ctx, programs, vox, direct_faces: Faces, volumes: ConeVolumes, s: VctSettings) -> ConeVolumes:
     """bounces − 1 gathers at the voxel faces (vct/bounce.glsl), each followed by a re-mip. Returns the volumes
     the final gather reads (a non-owning view of `volumes` when bounces = 1); `bounce_stats` lists the flux the
     faces carry after each bounce (bounce 1 = direct light reflected once)."""
@@ -38,7 +38,7 @@ def bounce(ctx, programs, vox, direct_faces: Faces, volumes: ConeVolumes, s: Vct
         unit = bind_samplers(prog, "u_direct", direct_faces.textures, unit)
         unit = bind_samplers(prog, "u_centroid", direct_faces.centroids, unit)
         bind_samplers(prog, "u_albedo", [vox.albedo], unit)
-        bind_cones(prog, grid, volumes.levels, replace(s, diffuse_cones=s.bounce_cones or s.diffuse_cones), world)
+        bind_cones(prog, grid, volumes.levels, replace(s, diffuse_cones=s.bounce_cones or s.diffuse_cones))
         for i, t in enumerate(faces.textures):
             t.bind_to_image(i, read=False, write=True)
         dispatch(prog, grid.size)

@@ -4,7 +4,7 @@
     vct_voxelize    ← geometry, materials, grid
     vct_inject      ← voxels, shadow maps (lights)
     vct_mipmap      ← injection, anisotropy
-    vct_bounce      ← mipmaps, world, cone settings, bounces
+    vct_bounce      ← mipmaps, cone settings, bounces
     vct_specular    ← gbuffer, bounced volumes, specular settings
     vct_trace       ← gbuffer, bounced volumes, trace settings, accumulation frame
     vct_upsample    ← vct_trace (indirect_scale > 1)
@@ -26,7 +26,6 @@ def run(frame) -> MethodOutput:
     ctx, programs, cache, scene, s = frame.ctx, frame.programs, frame.cache, frame.scene, frame.settings.vct
     grid = vct_grid(scene, s)
     levels = mip_levels(s.resolution)
-    world = tuple(float(c) for c in scene.world.color[:3])
     k_vox = (frame.keys["geometry"], frame.keys["materials"], grid.key())
     vox = cache.run("vct_voxelize", k_vox,
                     lambda: voxelize_scene(ctx, programs, scene, frame.geometry, frame.textures, grid))
@@ -35,19 +34,19 @@ def run(frame) -> MethodOutput:
                                                                     frame.textures, vox, frame.shadows, levels))
     k_mip = (k_inject, s.anisotropic)
     volumes = cache.run("vct_mipmap", k_mip, lambda: mipmap.build_volumes(ctx, programs, faces, s.anisotropic))
-    k_bounce = (k_mip, world, s.key("bounce"))
+    k_bounce = (k_mip, s.key("bounce"))
     bounced = cache.run("vct_bounce", k_bounce,
-                        lambda: bounce.bounce(ctx, programs, vox, faces, volumes, s, world))
+                        lambda: bounce.bounce(ctx, programs, vox, faces, volumes, s))
     k_spec = (frame.keys["gbuffer"], k_bounce, s.key("specular"))
     glossy = cache.run("vct_specular", k_spec, lambda: specular.specular(ctx, programs, frame.gbuffer, faces,
-                                                                         bounced, s, world))
-    indirect, k_trace, extra = _per_pixel(frame, faces, bounced, world, (frame.keys["gbuffer"], k_bounce,
+                                                                         bounced, s))
+    indirect, k_trace, extra = _per_pixel(frame, faces, bounced, (frame.keys["gbuffer"], k_bounce,
                                                                           s.key("trace")))
     info = {**trace.render_info(faces, bounced, s), "specular_pixels": glossy["traced"], **extra}
     return MethodOutput(indirect, glossy["glossy"], (k_trace, k_spec), info, has_ao=True)
 
 
-def _per_pixel(frame, faces, bounced, world, base):
+def _per_pixel(frame, faces, bounced, base):
     """The per-pixel cones: trace, upsample (indirect_scale > 1), temporal accumulation (temporal_frames > 1).
     The trace's inputs (`base`) key the history; while it holds fewer than temporal_frames frames, the frame
     index makes the keys new, so trace (and upsample) run again with the next jitter. Returns (texture, the
@@ -58,13 +57,13 @@ def _per_pixel(frame, faces, bounced, world, base):
     index = temporal.frame_index(prior.value if prior and accumulating else None, base, s.temporal_frames)
     rotation = temporal.jitter_deg(s, index) if accumulating else s.cone_rotation
     k_trace = (base, index)
-    traced = cache.run("vct_trace", k_trace, lambda: trace.trace(ctx, programs, gbuffer, faces, bounced, s, world,
+    traced = cache.run("vct_trace", k_trace, lambda: trace.trace(ctx, programs, gbuffer, faces, bounced, s,
                                                                  rotation))
     info = {}
     indirect = traced["indirect"]
     if s.indirect_scale > 1:
         up = cache.run("vct_upsample", k_trace, lambda: upsample.upsample(
-            ctx, programs, gbuffer, traced, faces, bounced, s, world, rotation))
+            ctx, programs, gbuffer, traced, faces, bounced, s, rotation))
         indirect, info["fixup_pixels"] = up["indirect"], up["fixup"]
     if accumulating:
         history = cache.run("vct_accumulate", k_trace, lambda: temporal.accumulate(

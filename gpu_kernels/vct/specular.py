@@ -31,7 +31,7 @@ def aperture_deg(roughness: float) -> float:
     return min(math.degrees(2.0 * math.atan(float(roughness) ** 2)), MAX_HALF_ANGLE_DEG)
 
 
-def specular(ctx, programs, gbuffer, faces: Faces, volumes: ConeVolumes, s: VctSettings, world) -> dict:
+def specular(ctx, programs, gbuffer, faces: Faces, volumes: ConeVolumes, s: VctSettings) -> dict:
     """{'glossy': RGBA32F texture at full resolution (rgb = Glossy Indirect, a = 1 where a cone ran),
     'traced': pixels that ran a cone}. Nothing is dispatched when s.specular_cone is off (texture of zeros)."""
     w, h = gbuffer.size
@@ -44,7 +44,7 @@ def specular(ctx, programs, gbuffer, faces: Faces, volumes: ConeVolumes, s: VctS
     unit = bind_samplers(prog, "u_centroid", faces.centroids, unit)
     for name in ("position", "normal", "geo_normal", "glossy"):
         unit = bind_samplers(prog, f"u_{name}", [gbuffer.textures[name]], unit)
-    bind_cones(prog, volumes.grid, volumes.levels, s, world)
+    bind_cones(prog, volumes.grid, volumes.levels, s)
     set_uniforms(prog, {"u_image_size": (w, h), "u_camera_position": gbuffer.eye, "u_camera_forward": gbuffer.forward,
                         "u_camera_ortho": bool(gbuffer.ortho), "u_roughness_cutoff": float(s.roughness_cutoff)})
     out.bind_to_image(0, read=False, write=True)

@@ -6,7 +6,7 @@ A few cones integrate the hemisphere coarsely: the cone set sees a bright patch 
 turned about the normal. Each render of an unchanged view k = 0, 1, … turns the set by another angle (`jitter_deg`)
 and the history keeps the mean of frames 0..k (vct/accumulate.glsl), so the picture converges to the average over
 turns. Frame 0 is unrotated, so the first frame after a reset equals a render without accumulation. The history is
-keyed by every input of the trace (G-buffer: geometry, materials, camera; bounced volumes: lights, world, VCT
+keyed by every input of the trace (G-buffer: geometry, materials, camera; bounced volumes: lights, VCT
 settings; the trace settings): a change restarts it at frame 0, so nothing of the old scene survives (no ghosting).
 vct/passes._per_pixel advances one frame per render until VctSettings.temporal_frames are in, then skips.
 """

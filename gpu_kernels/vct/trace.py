@@ -15,7 +15,7 @@ from .settings import VctSettings
 from .volumes import ConeVolumes, Faces, bind_volumes
 
 
-def bind_cones(prog, grid: Grid, levels: int, s: VctSettings, world) -> None:
+def bind_cones(prog, grid: Grid, levels: int, s: VctSettings) -> None:
     """Grid, cone table and trace settings of vct/common.glsl."""
     dirs, weights, tans = cone_table(s.diffuse_cones, s.diffuse_aperture)
     n = len(weights)
@@ -27,11 +27,10 @@ def bind_cones(prog, grid: Grid, levels: int, s: VctSettings, world) -> None:
     write_uniform(prog, "u_cone_tan", tan)
     bind_grid(prog, grid, levels)
     set_uniforms(prog, {"u_cone_count": n, "u_step": float(s.step_multiplier), "u_offset": float(s.start_offset),
-                        "u_max_distance": float(s.max_distance), "u_ao_distance": float(s.ao_distance),
-                        "u_world": tuple(float(c) for c in world[:3])})
+                        "u_max_distance": float(s.max_distance), "u_ao_distance": float(s.ao_distance)})
 
 
-def trace(ctx, programs, gbuffer, faces: Faces, volumes: ConeVolumes, s: VctSettings, world,
+def trace(ctx, programs, gbuffer, faces: Faces, volumes: ConeVolumes, s: VctSettings,
           rotation_deg: float | None = None) -> dict:
     """Diffuse cones per G-buffer pixel, or per indirect_scale² block (vct/trace.glsl): {'indirect': RGBA32F
     texture of ceil(W/s) × ceil(H/s), rgb = Diffuse Indirect (irradiance/π), a = voxel AO; 'scale': s}. The cone
@@ -40,7 +39,7 @@ def trace(ctx, programs, gbuffer, faces: Faces, volumes: ConeVolumes, s: VctSett
     fw, fh = gbuffer.size
     w, h = -(-fw // scale), -(-fh // scale)
     out = ctx.texture((w, h), 4, dtype="f4")
-    prog = trace_program(programs, gbuffer, faces, volumes, s, world, rotation_deg, fixup=False)
+    prog = trace_program(programs, gbuffer, faces, volumes, s, rotation_deg, fixup=False)
     set_uniform(prog, "u_image_size", (w, h))
     set_uniform(prog, "u_scale", scale)
     out.bind_to_image(0, read=False, write=True)
@@ -49,11 +48,11 @@ def trace(ctx, programs, gbuffer, faces: Faces, volumes: ConeVolumes, s: VctSett
     return {"indirect": out, "scale": scale}
 
 
-def fixup(ctx, programs, gbuffer, faces: Faces, volumes: ConeVolumes, s: VctSettings, world, texture,
+def fixup(ctx, programs, gbuffer, faces: Faces, volumes: ConeVolumes, s: VctSettings, texture,
           rotation_deg: float | None = None) -> None:
     """Trace, in place and at full resolution, the pixels of `texture` that vct/upsample.glsl marked (a < 0)."""
     w, h = gbuffer.size
-    prog = trace_program(programs, gbuffer, faces, volumes, s, world, rotation_deg, fixup=True)
+    prog = trace_program(programs, gbuffer, faces, volumes, s, rotation_deg, fixup=True)
     set_uniform(prog, "u_image_size", (w, h))
     set_uniform(prog, "u_scale", 1)
     texture.bind_to_image(0, read=True, write=True)
@@ -61,7 +60,7 @@ def fixup(ctx, programs, gbuffer, faces: Faces, volumes: ConeVolumes, s: VctSett
     ctx.memory_barrier()
 
 
-def trace_program(programs, gbuffer, faces, volumes, s, world, rotation_deg, fixup: bool):
+def trace_program(programs, gbuffer, faces, volumes, s, rotation_deg, fixup: bool):
     # Anisotropic volumes carry the layer volume the sub-rays need to find where surfaces lie (vct/crossing.glsl).
     defines = {"MODE_ANISO": None, "MODE_CROSSING": None, "SUBRAYS": int(s.subrays)} if volumes.anisotropic else {}
     if fixup:
@@ -71,7 +70,7 @@ def trace_program(programs, gbuffer, faces, volumes, s, world, rotation_deg, fix
     unit = bind_samplers(prog, "u_centroid", faces.centroids, unit)
     for name in ("position", "normal", "geo_normal"):
         unit = bind_samplers(prog, f"u_{name}", [gbuffer.textures[name]], unit)
-    bind_cones(prog, volumes.grid, volumes.levels, s, world)
+    bind_cones(prog, volumes.grid, volumes.levels, s)
     if volumes.anisotropic:
         set_uniform(prog, "u_subray_radius", subray_radius(s.subrays))
     phi = math.radians(s.cone_rotation if rotation_deg is None else rotation_deg)

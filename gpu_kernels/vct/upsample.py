@@ -16,13 +16,13 @@ from .trace import fixup
 SIGMA_VOXELS = 0.5  # plane-distance scale in voxels (vct/upsample.glsl says why)
 
 
-def upsample(ctx, programs, gbuffer, low: dict, faces, volumes, s, world, rotation_deg=None) -> dict:
+def upsample(ctx, programs, gbuffer, low: dict, faces, volumes, s, rotation_deg=None) -> dict:
     """{'indirect': full-resolution RGBA32F texture (rgb Diffuse Indirect, a AO), 'fixup': pixels traced again at
     full resolution}. `low` is vct/trace.trace's output at s.indirect_scale."""
     out, marked = joint_bilateral(ctx, programs, gbuffer, low["indirect"], int(low["scale"]),
                                   SIGMA_VOXELS * volumes.grid.cell)
     if marked:
-        fixup(ctx, programs, gbuffer, faces, volumes, s, world, out, rotation_deg)
+        fixup(ctx, programs, gbuffer, faces, volumes, s, out, rotation_deg)
     return {"indirect": out, "fixup": marked}
 
 

@@ -263,11 +263,12 @@ def test_pipeline_reruns_only_what_changed(engine, settings):
     assert not np.array_equal(fourth.passes["Position"], third.passes["Position"])
     check_direct(fourth.passes, turned.lights[0], -50.0)
 
-    # Change only the world colour: just compose re-runs (the background of Combined changes).
+    # Change only the world colour: the world is a light (common/lights.py: the sky light), so the light passes
+    # re-run — shadow maps, direct light, compose — and geometry, textures, G-buffer do not.
     world = make_scene(sun(-50.0), cam2)
     world.world.color = (0.1, 0.2, 0.3)
     fifth = engine.render(world, settings)
-    assert set(fifth.skipped) == ALL_PASSES - {"compose"}
+    assert set(fifth.skipped) == {"geometry", "textures", "emitter_shells", "gbuffer"}
 
 
 def test_a_pass_keeps_as_many_outputs_as_asked_and_releases_the_rest():

@@ -30,7 +30,7 @@ ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..")
 sys.path.insert(0, ROOT)
 
 # The passes of the table: Cycles' (examples.references.PASSES), then the diffuse light (Direct + Indirect: Cycles
-# counts the world's light as direct, the conventions let us count it as indirect, so only their sum compares).
+# counts the world's light as direct, as we do since the sky light; their sum is kept as a check of the total).
 DERIVED = "Diffuse Light"
 MATCH = "Diffuse Color match"  # share of hit pixels whose Diffuse Color is within 0.01 of Cycles' in every channel
 MATCH_TOLERANCE = 0.01

@@ -94,15 +94,30 @@ def test_the_factored_series_equals_the_bounce_by_bounce_series():
     t = tr.sort_by_cluster(c, matrix)
     weight = rng.uniform(0.2, 0.9, (r, 3)) * areas[:, None]
     first = rng.uniform(0, 5, (c.count, 3))
-    world = rng.uniform(0, 0.1, (2, r, 3))
     m = tr.albedo_transfer(t, weight)
-    total, passes = tr.solve(t, m, weight, first, world, bounces=5, epsilon=0.0)
+    total, passes = tr.solve(t, m, first, bounces=5, epsilon=0.0)
 
-    expected = world.copy()
+    expected = np.zeros_like(total, np.float64)
     phi = first
     for k in range(5):
         e = np.stack([(matrix[s].T @ phi) for s in range(2)])
         expected += e
-        phi = tr.reflect(c, weight, e + (world if k == 0 else 0))
+        phi = tr.reflect(c, weight, e)
     assert len(passes) == 5
     assert np.abs(total - expected).max() <= 1e-5 * np.abs(expected).max()
+
+
+def test_a_cluster_never_delivers_more_than_its_flux():
+    """conserving_gain scales exactly the clusters whose T delivers more than one watt per watt (Σ sides, receivers
+    of T·area) down to one watt and leaves the others; solve() then carries the scaled flux. A row delivering 1.6 W/W
+    (what 2 cm walls gave: thin_walls' median) would make every bounce grow with albedo 0.8 (1.6 × 0.8 > 1)."""
+    areas = np.array([1.0, 2.0, 0.5])
+    matrix = np.zeros((2, 3, 3), np.float32)
+    matrix[0, 0] = (0.4, 0.3, 0.0)   # delivers 1.0 W: kept
+    matrix[0, 1] = (0.2, 0.2, 0.4)   # 0.8 W: kept
+    matrix[0, 2] = (0.5, 0.3, 0.4)   # 1.3 W on the front...
+    matrix[1, 2] = (0.0, 0.1, 0.2)   # ... + 0.3 W on the back = 1.6 W: scaled by 1/1.6
+    gain = tr.conserving_gain(matrix, areas)
+    np.testing.assert_allclose(gain, [1.0, 1.0, 1 / 1.6], rtol=1e-6)
+    delivered = sum(matrix[s] @ areas for s in range(2)) * gain
+    assert delivered.max() <= 1.0 + 1e-6

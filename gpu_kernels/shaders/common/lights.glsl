@@ -7,6 +7,7 @@
 #define LIGHT_POINT 1
 #define LIGHT_SPOT 2
 #define LIGHT_POLYGON 3   // area lights and emissive triangles
+#define LIGHT_SKY 4       // the world: constant radiance from every direction, shadowed from many directions
 #define MAX_POLYGON_VERTICES 34  // a 32-gon plus one vertex per clipping plane, with margin
 
 struct GpuLight {

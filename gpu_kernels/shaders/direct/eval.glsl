@@ -6,6 +6,8 @@
 #include "common/lights.glsl"
 #include "common/light_eval.glsl"
 
+
+#define OFFSET_TEXELS 1.5
 uniform sampler2DShadow u_shadow_atlas;
 uniform vec2 u_atlas_texel;        // 1 / atlas size
 // true for VCT's injection: the samples facing the sealed inside of a closed emitter (ShadowView.emitter.w < 0)
@@ -15,20 +17,23 @@ uniform bool u_exclude_trapped;
 
 // Visibility of world point p from one shadow view with a normal-offset bias and percentage-closer filtering.
 // The offset grows with the shadow texel's world footprint, which removes acne without a hand-tuned constant.
-vec3 biased_point(ShadowView v, vec3 p, vec3 geo_n, vec3 to_light) {
+vec3 biased_point(ShadowView v, vec3 p, vec3 geo_n, vec3 to_light, float max_slope) {
     bool ortho = v.origin.w > 0.5;
     float dist = ortho ? 1.0 : length(p - v.origin.xyz);
     float texel_world = v.info.x * dist;
     float cos_l = clamp(dot(geo_n, to_light), 0.0, 1.0);
     float sin_l = sqrt(max(0.0, 1.0 - cos_l * cos_l));
     // 1.5 texels along the normal, more at grazing angles (slope-scaled), capped.
-    return p + geo_n * texel_world * (1.5 + 2.0 * min(sin_l / max(cos_l, 0.05), 8.0));
+    return p + geo_n * texel_world * (OFFSET_TEXELS + 2.0 * min(sin_l / max(cos_l, 0.05), max_slope));
 }
 
-float view_visibility(int view_index, vec3 p, vec3 geo_n, vec3 to_light) {
+// max_slope caps the slope-scaled part of the offset (8 for a light's own maps; 0 for the sky's many directions: a
+// grazing one pushed far off the surface would test a point beyond a thin wall, and acne in a few of them is
+// averaged away).
+float view_visibility_biased(int view_index, vec3 p, vec3 geo_n, vec3 to_light, float max_slope) {
     ShadowView v = shadow_views[view_index];
     bool ortho = v.origin.w > 0.5;
-    vec3 q = biased_point(v, p, geo_n, to_light);
+    vec3 q = biased_point(v, p, geo_n, to_light, max_slope);
     vec4 clip = v.view_projection * vec4(q, 1.0);
     vec3 ndc = clip.xyz / clip.w;
     if (clip.w <= 0.0) return 1.0;
@@ -41,6 +46,14 @@ float view_visibility(int view_index, vec3 p, vec3 geo_n, vec3 to_light) {
     vec2 atlas_uv = v.tile.xy + uv * v.tile.zw;
     // PCF: a (2r+1)² grid of bilinear hardware comparisons.
     int r = int(v.info.y);
+    // PCF radius 0 (the sky's maps): shadowed if any of the four texels around p is — a wall meeting the floor
+    // at a grazing angle to the view changes depth by more than its distance to p across one texel, so the nearest
+    // texel alone can read the wall as behind p and let the sky in at its foot. The sky's many directions are
+    // its penumbra, so this one-texel dilation of each direction's shadow costs nothing visible.
+    if (r == 0) {
+        vec4 g = textureGather(u_shadow_atlas, clamp(atlas_uv, lo, hi), depth);
+        return min(min(g.x, g.y), min(g.z, g.w));
+    }
     float sum = 0.0;
     for (int j = -r; j <= r; ++j)
         for (int i = -r; i <= r; ++i) {
@@ -50,6 +63,10 @@ float view_visibility(int view_index, vec3 p, vec3 geo_n, vec3 to_light) {
     return sum / float((2 * r + 1) * (2 * r + 1));
 }
 
+float view_visibility(int view_index, vec3 p, vec3 geo_n, vec3 to_light) {
+    return view_visibility_biased(view_index, p, geo_n, to_light, 8.0);
+}
+
 // The face is chosen for the biased point, the one the test projects: chosen for p, a point near a face's edge
 // could be pushed out of that face's frustum (past its two-texel margin) and read as unshadowed — light came through
 // closed walls where rays ran close to a cube seam (tests/stress/test_lights_camera.py). All six faces share the
@@ -57,7 +74,7 @@ float view_visibility(int view_index, vec3 p, vec3 geo_n, vec3 to_light) {
 float cube_visibility(int first_view, vec3 p, vec3 geo_n) {
     vec3 origin = shadow_views[first_view].origin.xyz;
     vec3 to_light = normalize(origin - p);
-    vec3 q = biased_point(shadow_views[first_view], p, geo_n, to_light);
+    vec3 q = biased_point(shadow_views[first_view], p, geo_n, to_light, 8.0);
     return view_visibility(first_view + cube_face(q - origin), p, geo_n, to_light);
 }
 
@@ -86,11 +103,47 @@ float polygon_visibility(GpuLight L, vec3 p, vec3 n, vec3 geo_n) {
     return wsum > 0.0 ? vsum / wsum : 1.0;
 }
 
+// Visibility of the sky light from its K directions d_k (ShadowView.emitter: d_k and its solid angle), weighted
+// by w_k(d_k): the cosine max(0, n·d_k) for irradiance (sky_visibility), the glossy lobe for reflection
+// (sky_lobe_visibility). A quadrature over the sphere of the visible share of the world; each direction's map holds
+// the scene's own triangles, so thin and one-sided walls block exactly.
+float sky_weighted_visibility(GpuLight L, vec3 p, vec3 geo_n, vec3 axis, float sharpness, bool cosine) {
+    int samples = int(L.params.z);
+    if (samples == 0) return 1.0;
+    int first = int(L.params.y);
+    float wsum = 0.0, vsum = 0.0;
+    for (int k = 0; k < samples; ++k) {
+        vec3 d = shadow_views[first + k].emitter.xyz;
+        float c = dot(axis, d);
+        float w = cosine ? max(c, 0.0) : exp(sharpness * (c - 1.0));
+        // Directions below the surface see its back; grazing ones (cos < 0.1: 1% of the irradiance) would need
+        // an offset larger than a thin wall is thick, so they take the others' mean (left out of both sums).
+        if (w <= 1e-4 || dot(geo_n, d) < 0.1) continue;
+        wsum += w;
+        vsum += w * view_visibility_biased(first + k, p, geo_n, d, 0.0);
+    }
+    return wsum > 0.0 ? vsum / wsum : 0.0;
+}
+
+float sky_visibility(GpuLight L, vec3 p, vec3 n, vec3 geo_n) {
+    return sky_weighted_visibility(L, p, geo_n, n, 0.0, true);
+}
+
+// The sky seen through a glossy lobe about the mirror direction r: a von Mises–Fisher weight exp(κ(r·d − 1)) whose
+// width is the lobe's (GGX α: an angular spread of about 2α about r after reflection) widened to the spacing of the
+// sky directions (4π/K per direction), so a mirror still averages its few nearest directions rather than one.
+float sky_lobe_visibility(GpuLight L, vec3 p, vec3 geo_n, vec3 r, float alpha) {
+    float spacing2 = 4.0 * PI / max(L.params.z, 1.0);
+    float spread2 = 4.0 * alpha * alpha + spacing2;
+    return sky_weighted_visibility(L, p, geo_n, r, 1.0 / spread2, false);
+}
+
 // Unshadowed direct irradiance of one light at p (normal n).
 vec3 light_unshadowed(GpuLight L, vec3 p, vec3 n) {
     int type = int(L.color_type.w);
     vec3 color = L.color_type.rgb;
     if (type == LIGHT_SUN) return color * max(dot(n, -L.direction.xyz), 0.0);
+    if (type == LIGHT_SKY) return color * PI;  // ∫ L·max(0, n·ω) dω over the sphere
     if (type == LIGHT_POINT || type == LIGHT_SPOT) {
         vec3 d = L.position.xyz - p;
         float d2 = max(dot(d, d), 1e-8);
@@ -113,6 +166,7 @@ float light_visibility(GpuLight L, vec3 p, vec3 n, vec3 geo_n) {
     if (type == LIGHT_SUN) return view_visibility(int(L.params.y), p, geo_n, -L.direction.xyz);
     if (type == LIGHT_POINT) return cube_visibility(int(L.params.y), p, geo_n);
     if (type == LIGHT_SPOT) return view_visibility(int(L.params.y), p, geo_n, normalize(L.position.xyz - p));
+    if (type == LIGHT_SKY) return sky_visibility(L, p, n, geo_n);
     return polygon_visibility(L, p, n, geo_n);
 }
 

@@ -41,8 +41,10 @@ void main() {
     vec4 spec = texelFetch(u_specular, px, 0);
     vec3 v = u_ortho ? -u_forward : normalize(u_eye - pos.xyz);
     GlossyLobe lobe = GlossyLobe(glossy.w * glossy.w, int(spec.w + 0.5), dot(n, v), spec.rgb);
-    vec3 irradiance = vec3(0.0), reflected = vec3(0.0);
+    vec3 irradiance = vec3(0.0), reflected = vec3(0.0), world = vec3(0.0);
     for (int i = 0; i < u_light_count; ++i) {
+        if (has_glossy && int(lights[i].color_type.w) == LIGHT_SKY)
+            world += sky_glossy(lobe, lights[i], pos.xyz, n, geo_n, v);
         vec3 e = light_unshadowed(lights[i], pos.xyz, n);
         vec3 g = has_glossy ? light_glossy(u_material_lut, lobe, lights[i], pos.xyz, n, v) : vec3(0.0);
         if (max(max(e.r, e.g), max(max(e.b, g.r), max(g.g, g.b))) <= 0.0) continue;
@@ -51,7 +53,7 @@ void main() {
         reflected += g * vis;
     }
     float e_mu = max(principled_ggx_albedo(u_material_lut, lobe.material, lobe.mu), 1e-4);
-    vec3 glossy_direct = has_glossy ? reflected / (e_mu * max(glossy.rgb, vec3(1e-6))) : vec3(0.0);
+    vec3 glossy_direct = has_glossy ? reflected / (e_mu * max(glossy.rgb, vec3(1e-6))) + world : vec3(0.0);
     imageStore(u_diffuse_direct, px, vec4(irradiance / PI, 1.0));
     imageStore(u_glossy_direct, px, vec4(glossy_direct, 1.0));
 }

@@ -20,7 +20,7 @@
 //
 // MODE_TRANSFER writes the kernel per receiver and source instead (lpv/transfer.py: the cached transport).
 //
-// The result is added, per side, to what lpv/absorb.glsl found (world light, which still propagates), so the flux
+// The result is added, per side, to what lpv/absorb.glsl found (zeros: world light is the sky light's VPLs), so the flux
 // lookup (lpv/lighting.glsl, MODE_FLUX) reads it unchanged; the next bounce's VPLs come from it (lpv/cluster.glsl).
 #include "lpv/common.glsl"
 

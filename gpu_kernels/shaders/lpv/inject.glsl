@@ -53,6 +53,11 @@ vec3 vpl_flux(RsmView v, vec3 p, vec3 n, vec3 albedo) {
         float cosine = dot(n, -L.direction.xyz);
         return cosine > 0.0 ? albedo * color * v.params.y * v.params.y : vec3(0.0);
     }
+    if (type == LIGHT_SKY) {
+        // Sky direction k (ShadowView.emitter: d_k, its solid angle Ω_k) is a sun of irradiance L·Ω_k along −d_k.
+        vec4 e = shadow_views[int(L.params.y) + int(v.params.w)].emitter;
+        return dot(n, e.xyz) > 0.0 ? albedo * color * e.w * v.params.y * v.params.y : vec3(0.0);
+    }
     if (type == LIGHT_POINT || type == LIGHT_SPOT) {
         // E·A = I·cosθ/(d²+r²) · d²Ω/cosθ = I·Ω·d²/(d²+r²): the light's flux into the texel's solid angle.
         vec3 d = p - L.position.xyz;

@@ -24,7 +24,6 @@ uniform float u_step;            // step length / sampled voxel size (Freed 2018
 uniform float u_offset;          // start offset along the geometric normal, in voxels (scaled by ‖n‖₁, see below)
 uniform float u_max_distance;    // metres; 0 = until the cone leaves the grid
 uniform float u_ao_distance;     // metres; 0 = AO is the sky visibility (transmittance of cones leaving the grid)
-uniform vec3 u_world;            // world (background) radiance, seen through what is left of a cone leaving the grid
 
 uniform sampler3D u_centroid[6]; // vct/inject.glsl: per face, xyz = its surface centroid, w = ±coverage (0: no surface)
 #include "vct/arrays.glsl"
@@ -187,7 +186,9 @@ vec3 cone_origin(vec3 p, vec3 n_geo) {
 #endif
 
 // Irradiance E at p over the hemisphere of n (rgb), and the cosine-weighted AO / sky visibility (a, in [0, 1]):
-// E = Σ_k w_k·(L_k + T_k·L_world if cone k left the grid), with Σ_k w_k = π (vct/cones.cone_table).
+// E = Σ_k w_k·L_k, with Σ_k w_k = π (vct/cones.cone_table). The world a cone reaches is not added: it is a light
+// (common/lights.py: the sky light), its direct light shadowed by the real triangles and its bounce injected into the
+// voxels like any light's, since a voxel's fuzzy opacity lets the sky through walls thinner than a voxel.
 // rot = (cos φ, sin φ): the cone set turned by φ around the normal (vct/temporal.py jitters φ from frame to frame;
 // the weights are unchanged, since rotating the regions about the normal keeps their cosine integrals).
 vec4 gather_irradiance(vec3 p, vec3 n, vec3 n_geo, vec2 rot) {
@@ -205,7 +206,7 @@ vec4 gather_irradiance(vec3 p, vec3 n, vec3 n_geo, vec2 rot) {
 #else
         ConeResult r = trace_cone(p, o, n_geo, d, u_cone_tan[k]);
 #endif
-        e += c.w * (r.radiance + (r.exited ? r.transmittance * u_world : vec3(0.0)));
+        e += c.w * r.radiance;
         ao += c.w * r.ao;
     }
     return vec4(e, ao / VCT_PI);

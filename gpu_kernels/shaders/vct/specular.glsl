@@ -47,7 +47,7 @@ void main() {
     float alpha = glossy.w * glossy.w;
     float tan_half = tan(min(2.0 * atan(alpha), MAX_HALF_ANGLE));
     ConeResult c = trace_cone(pos.xyz, cone_origin(pos.xyz, geo_n), geo_n, r, tan_half);
-    vec3 radiance = c.radiance + (c.exited ? c.transmittance * u_world : vec3(0.0));
+    vec3 radiance = c.radiance;  // the world it reflects is Glossy Direct (direct/ggx.glsl: sky_glossy)
     atomicAdd(traced, 1u);
     imageStore(u_out, px, vec4(radiance, 1.0));
 }
