@@ -207,6 +207,20 @@ def checker_image(name="Checker", size=64, checks=2, colors=(CHECKER_A, CHECKER_
     return img
 
 
+def uv_image_node(nt, image):
+    """An Image Texture node (repeat extension, linear filter) of `image` read through the "UVMap" UV map, in node
+    tree `nt`; link its Color output where the image should go."""
+    tex = nt.nodes.new("ShaderNodeTexImage")
+    tex.image = image
+    tex.extension = "REPEAT"
+    tex.interpolation = "Linear"
+    uv = nt.nodes.new("ShaderNodeUVMap")
+    uv.uv_map = "UVMap"
+    uv.location, tex.location = (-900, 0), (-650, 0)
+    nt.links.new(uv.outputs["UV"], tex.inputs["Vector"])
+    return tex
+
+
 def textured_material(name, image):
     """UV-mapped Image Texture -> Diffuse BSDF (repeat extension, linear filter)."""
     mat = bpy.data.materials.new(name)
@@ -215,15 +229,8 @@ def textured_material(name, image):
     out = nt.nodes.new("ShaderNodeOutputMaterial")
     bsdf = nt.nodes.new("ShaderNodeBsdfDiffuse")
     bsdf.inputs["Roughness"].default_value = 0.0
-    tex = nt.nodes.new("ShaderNodeTexImage")
-    tex.image = image
-    tex.extension = "REPEAT"
-    tex.interpolation = "Linear"
-    uv = nt.nodes.new("ShaderNodeUVMap")
-    uv.uv_map = "UVMap"
-    uv.location, tex.location, bsdf.location = (-900, 0), (-650, 0), (-300, 0)
-    nt.links.new(uv.outputs["UV"], tex.inputs["Vector"])
-    nt.links.new(tex.outputs["Color"], bsdf.inputs["Color"])
+    bsdf.location = (-300, 0)
+    nt.links.new(uv_image_node(nt, image).outputs["Color"], bsdf.inputs["Color"])
     nt.links.new(bsdf.outputs["BSDF"], out.inputs["Surface"])
     mat.diffuse_color = (*np.mean([CHECKER_A, CHECKER_B], axis=0), 1.0)
     return mat
@@ -253,15 +260,7 @@ def principled_material(name, color=DEFAULT_BASE, roughness=DEFAULT_ROUGHNESS, m
         bsdf.inputs["Emission Color"].default_value = (*emission, 1.0)
         bsdf.inputs["Emission Strength"].default_value = emission_strength
     if image is not None:
-        tex = nt.nodes.new("ShaderNodeTexImage")
-        tex.image = image
-        tex.extension = "REPEAT"
-        tex.interpolation = "Linear"
-        uv = nt.nodes.new("ShaderNodeUVMap")
-        uv.uv_map = "UVMap"
-        uv.location, tex.location = (-900, 0), (-650, 0)
-        nt.links.new(uv.outputs["UV"], tex.inputs["Vector"])
-        nt.links.new(tex.outputs["Color"], bsdf.inputs["Base Color"])
+        nt.links.new(uv_image_node(nt, image).outputs["Color"], bsdf.inputs["Base Color"])
     mat.diffuse_color = (*color, 1.0)
     return mat
 

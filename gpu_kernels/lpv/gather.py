@@ -26,7 +26,6 @@ from ..common.bounce_tail import tail_ratio, tail_sum
 from ..common.grid import Grid
 from ..gl.bind import bind_grid, bind_light_records, bind_named, dispatch, set_uniform, zero_texture
 from .occlusion import absorb
-from .propagate import propagate
 from .settings import LpvSettings
 from .state import LpvGridState
 

@@ -131,18 +131,6 @@ def update_transfer(ctx, programs, gv, grid: Grid, occlusion: bool, prior) -> tu
     return new, matrix, share
 
 
-def reflect(clusters: Clusters, weight: np.ndarray, irradiance: np.ndarray) -> np.ndarray:
-    """The flux the voxel sides reflect, per cluster (C, 3): Σ albedo × area × E over each cluster's sides.
-    `weight` (R, 3) = albedo × area; `irradiance` (2, R, 3) per side."""
-    out = np.zeros((clusters.count, 3))
-    for side in range(2):
-        members = clusters.side_cluster[:, side]
-        use = members >= 0
-        for i in range(3):
-            out[:, i] += np.bincount(members[use], weight[use, i] * irradiance[side, use, i], clusters.count)
-    return out
-
-
 @dataclass
 class Transfer:
     """One cascade's cached transport: its clusters and T, each side's columns in the order of that side's

@@ -7,7 +7,8 @@
 #include "common/light_eval.glsl"
 
 
-#define OFFSET_TEXELS 1.5
+#define OFFSET_TEXELS 1.5  // normal offset of a shadow test, in shadow texels
+#define MAX_SLOPE 8.0      // cap of its slope-scaled part (tan θ) for a light's own maps
 uniform sampler2DShadow u_shadow_atlas;
 uniform vec2 u_atlas_texel;        // 1 / atlas size
 // true for VCT's injection: the samples facing the sealed inside of a closed emitter (ShadowView.emitter.w < 0)
@@ -27,7 +28,7 @@ vec3 biased_point(ShadowView v, vec3 p, vec3 geo_n, vec3 to_light, float max_slo
     return p + geo_n * texel_world * (OFFSET_TEXELS + 2.0 * min(sin_l / max(cos_l, 0.05), max_slope));
 }
 
-// max_slope caps the slope-scaled part of the offset (8 for a light's own maps; 0 for the sky's many directions: a
+// max_slope caps the slope-scaled part of the offset (MAX_SLOPE for a light's own maps; 0 for the sky's many directions: a
 // grazing one pushed far off the surface would test a point beyond a thin wall, and acne in a few of them is
 // averaged away).
 float view_visibility_biased(int view_index, vec3 p, vec3 geo_n, vec3 to_light, float max_slope) {
@@ -64,7 +65,7 @@ float view_visibility_biased(int view_index, vec3 p, vec3 geo_n, vec3 to_light, 
 }
 
 float view_visibility(int view_index, vec3 p, vec3 geo_n, vec3 to_light) {
-    return view_visibility_biased(view_index, p, geo_n, to_light, 8.0);
+    return view_visibility_biased(view_index, p, geo_n, to_light, MAX_SLOPE);
 }
 
 // The face is chosen for the biased point, the one the test projects: chosen for p, a point near a face's edge
@@ -74,7 +75,7 @@ float view_visibility(int view_index, vec3 p, vec3 geo_n, vec3 to_light) {
 float cube_visibility(int first_view, vec3 p, vec3 geo_n) {
     vec3 origin = shadow_views[first_view].origin.xyz;
     vec3 to_light = normalize(origin - p);
-    vec3 q = biased_point(shadow_views[first_view], p, geo_n, to_light, 8.0);
+    vec3 q = biased_point(shadow_views[first_view], p, geo_n, to_light, MAX_SLOPE);
     return view_visibility(first_view + cube_face(q - origin), p, geo_n, to_light);
 }
 
@@ -103,39 +104,31 @@ float polygon_visibility(GpuLight L, vec3 p, vec3 n, vec3 geo_n) {
     return wsum > 0.0 ? vsum / wsum : 1.0;
 }
 
-// Visibility of the sky light from its K directions d_k (ShadowView.emitter: d_k and its solid angle), weighted
-// by w_k(d_k): the cosine max(0, n·d_k) for irradiance (sky_visibility), the glossy lobe for reflection
-// (sky_lobe_visibility). A quadrature over the sphere of the visible share of the world; each direction's map holds
-// the scene's own triangles, so thin and one-sided walls block exactly.
-float sky_weighted_visibility(GpuLight L, vec3 p, vec3 geo_n, vec3 axis, float sharpness, bool cosine) {
+// Visibility of the sky light from its K directions d_k (ShadowView.emitter: d_k and its solid angle): the share of
+// the weight w_k of the directions that reach the sky. x: w_k = max(0, n·d_k), the cosine, for irradiance; y (when
+// `lobe`): the glossy lobe about the mirror direction r, a von Mises–Fisher weight exp(κ(r·d − 1)) whose width is
+// the lobe's (GGX α: an angular spread of about 2α about r after reflection) widened to the spacing of the
+// directions (4π/K each), so a mirror still averages its few nearest directions rather than one. Both shares come
+// from one shadow test per direction. A quadrature over the sphere of the visible share of the world; each
+// direction's map holds the scene's own triangles, so thin and one-sided walls block exactly.
+vec2 sky_shares(GpuLight L, vec3 p, vec3 n, vec3 geo_n, vec3 r, float alpha, bool lobe) {
     int samples = int(L.params.z);
-    if (samples == 0) return 1.0;
+    if (samples == 0) return vec2(1.0);
     int first = int(L.params.y);
-    float wsum = 0.0, vsum = 0.0;
+    float kappa = 1.0 / (4.0 * alpha * alpha + 4.0 * PI / float(samples));
+    vec2 wsum = vec2(0.0), vsum = vec2(0.0);
     for (int k = 0; k < samples; ++k) {
         vec3 d = shadow_views[first + k].emitter.xyz;
-        float c = dot(axis, d);
-        float w = cosine ? max(c, 0.0) : exp(sharpness * (c - 1.0));
         // Directions below the surface see its back; grazing ones (cos < 0.1: 1% of the irradiance) would need
         // an offset larger than a thin wall is thick, so they take the others' mean (left out of both sums).
-        if (w <= 1e-4 || dot(geo_n, d) < 0.1) continue;
+        if (dot(geo_n, d) < 0.1) continue;
+        vec2 w = vec2(max(dot(n, d), 0.0), lobe ? exp(kappa * (dot(r, d) - 1.0)) : 0.0);
+        w *= vec2(greaterThan(w, vec2(1e-4)));
+        if (max(w.x, w.y) <= 0.0) continue;
         wsum += w;
         vsum += w * view_visibility_biased(first + k, p, geo_n, d, 0.0);
     }
-    return wsum > 0.0 ? vsum / wsum : 0.0;
-}
-
-float sky_visibility(GpuLight L, vec3 p, vec3 n, vec3 geo_n) {
-    return sky_weighted_visibility(L, p, geo_n, n, 0.0, true);
-}
-
-// The sky seen through a glossy lobe about the mirror direction r: a von Mises–Fisher weight exp(κ(r·d − 1)) whose
-// width is the lobe's (GGX α: an angular spread of about 2α about r after reflection) widened to the spacing of the
-// sky directions (4π/K per direction), so a mirror still averages its few nearest directions rather than one.
-float sky_lobe_visibility(GpuLight L, vec3 p, vec3 geo_n, vec3 r, float alpha) {
-    float spacing2 = 4.0 * PI / max(L.params.z, 1.0);
-    float spread2 = 4.0 * alpha * alpha + spacing2;
-    return sky_weighted_visibility(L, p, geo_n, r, 1.0 / spread2, false);
+    return vec2(wsum.x > 0.0 ? vsum.x / wsum.x : 0.0, wsum.y > 0.0 ? vsum.y / wsum.y : 0.0);
 }
 
 // Unshadowed direct irradiance of one light at p (normal n).
@@ -166,7 +159,7 @@ float light_visibility(GpuLight L, vec3 p, vec3 n, vec3 geo_n) {
     if (type == LIGHT_SUN) return view_visibility(int(L.params.y), p, geo_n, -L.direction.xyz);
     if (type == LIGHT_POINT) return cube_visibility(int(L.params.y), p, geo_n);
     if (type == LIGHT_SPOT) return view_visibility(int(L.params.y), p, geo_n, normalize(L.position.xyz - p));
-    if (type == LIGHT_SKY) return sky_visibility(L, p, n, geo_n);
+    if (type == LIGHT_SKY) return sky_shares(L, p, n, geo_n, n, 0.0, false).x;
     return polygon_visibility(L, p, n, geo_n);
 }
 

@@ -8,7 +8,6 @@
 #include "common/lights.glsl"
 #include "common/light_eval.glsl"
 #include "common/principled.glsl"
-#include "direct/eval.glsl"  // sky_lobe_visibility
 
 #define GLOSSY_POLYGON_SAMPLES 24  // quadrature points per polygon light (at least one per fan triangle)
 
@@ -82,7 +81,7 @@ vec3 polygon_glossy(sampler2D lut, GlossyLobe g, GpuLight L, vec3 p, vec3 n, vec
 vec3 light_glossy(sampler2D lut, GlossyLobe g, GpuLight L, vec3 p, vec3 n, vec3 v) {
     if (g.alpha * g.alpha <= 5e-7) return vec3(0.0);  // Cycles evaluates no singular lobe against a light
     int type = int(L.color_type.w);
-    if (type == LIGHT_SKY) return vec3(0.0);  // the world's reflection: sky_glossy
+    if (type == LIGHT_SKY) return vec3(0.0);  // the world's reflection: direct/light.glsl, with its visibility
     vec3 color = L.color_type.rgb;
     if (type == LIGHT_SUN) return color * lobe_cos(lut, g, n, v, -L.direction.xyz);
     if (type == LIGHT_POINT || type == LIGHT_SPOT) {
@@ -94,13 +93,4 @@ vec3 light_glossy(sampler2D lut, GlossyLobe g, GpuLight L, vec3 p, vec3 n, vec3 
     }
     if (!(L.polygon.z > 0.5) && dot(p - L.position.xyz, L.direction.xyz) <= 0.0) return vec3(0.0);
     return polygon_glossy(lut, g, L, p, n, v);
-}
-
-// The world's reflection as Glossy Direct (Glossy Color divided out): a constant radiance L reflects as L times
-// the share of the lobe that sees the sky (direct/eval.glsl: sky_lobe_visibility), for any roughness — Cycles counts
-// the world a mirror shows as direct light too.
-vec3 sky_glossy(GlossyLobe g, GpuLight L, vec3 p, vec3 n, vec3 geo_n, vec3 v) {
-    if (g.mu <= 0.0) return vec3(0.0);
-    vec3 r = 2.0 * g.mu * n - v;
-    return L.color_type.rgb * sky_lobe_visibility(L, p, geo_n, r, g.alpha);
 }

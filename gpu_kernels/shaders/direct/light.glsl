@@ -43,8 +43,15 @@ void main() {
     GlossyLobe lobe = GlossyLobe(glossy.w * glossy.w, int(spec.w + 0.5), dot(n, v), spec.rgb);
     vec3 irradiance = vec3(0.0), reflected = vec3(0.0), world = vec3(0.0);
     for (int i = 0; i < u_light_count; ++i) {
-        if (has_glossy && int(lights[i].color_type.w) == LIGHT_SKY)
-            world += sky_glossy(lobe, lights[i], pos.xyz, n, geo_n, v);
+        if (int(lights[i].color_type.w) == LIGHT_SKY) {
+            // The world: irradiance π·L and, for any roughness, its reflection L (Glossy Color divided out; Cycles
+            // counts the world a mirror shows as direct light too), each times its share of the sky that is seen.
+            bool lobe_seen = has_glossy && lobe.mu > 0.0;
+            vec2 shares = sky_shares(lights[i], pos.xyz, n, geo_n, 2.0 * lobe.mu * n - v, lobe.alpha, lobe_seen);
+            irradiance += light_unshadowed(lights[i], pos.xyz, n) * shares.x;
+            if (lobe_seen) world += lights[i].color_type.rgb * shares.y;
+            continue;
+        }
         vec3 e = light_unshadowed(lights[i], pos.xyz, n);
         vec3 g = has_glossy ? light_glossy(u_material_lut, lobe, lights[i], pos.xyz, n, v) : vec3(0.0);
         if (max(max(e.r, e.g), max(max(e.b, g.r), max(g.g, g.b))) <= 0.0) continue;
