@@ -14,7 +14,7 @@ alone and the passes are instead:
     geometry_volume      ← geometry, grids                    (occupancy, normals, visibility planes)
     lpv_albedo           ← geometry volume, materials          (the surface voxels' albedo)
     lpv_transfer         ← geometry volume, budget             (clusters and the kernel T: the expensive part)
-    lpv_transfer_albedo  ← transfer, albedo                    (M_ρ: cluster-to-cluster reflection)
+    lpv_transfer_albedo  ← transfer, albedo                    (M_ρ: cluster-to-cluster reflection, bounded)
     lpv_inject           ← rsm, transfer                       (the RSM's flux per cluster)
     lpv_propagate        ← all of the above, bounces           (the bounce series and one product with T)
     lpv_lighting         ← gbuffer, transport
@@ -119,12 +119,12 @@ def transfer_bytes(scene, s) -> tuple[int, int]:
 def _transfer(frame, grids, k_grids, maps, k_rsm, budget) -> MethodOutput:
     """The cached transport's passes (lpv/transfer.py); see the module docstring for what each reads."""
     ctx, programs, cache, scene, s = frame.ctx, frame.programs, frame.cache, frame.scene, frame.settings.lpv
-    gvs, transfers, _, m_rho, keys = _transfer_geometry(frame, grids, k_grids, budget)
+    gvs, transfers, _, reflection, keys = _transfer_geometry(frame, grids, k_grids, budget)
     k_src = (k_rsm, keys["transfer"])
     sources = cache.run("lpv_inject", k_src, lambda: [clusters.bin_flux(t.clusters, gather.rsm_records(
         ctx, programs, maps, frame.shadows, grid, budget)[0]) for t, grid in zip(transfers, grids)])
     k_prop = (k_src, keys["albedo_transfer"], keys["gv"], s.max_iterations, s.clamp_negative, s.bounces, s.epsilon)
-    solved = cache.run("lpv_propagate", k_prop, lambda: _solve(ctx, gvs, grids, transfers, m_rho, sources, s))
+    solved = cache.run("lpv_propagate", k_prop, lambda: _solve(ctx, gvs, grids, transfers, reflection, sources, s))
     k_light = (frame.keys["gbuffer"], k_prop)
     indirect = cache.run("lpv_lighting", k_light,
                          lambda: lighting.lighting(ctx, programs, frame.gbuffer, solved["surfaces"], gvs, s))
@@ -156,9 +156,9 @@ def _transfer_geometry(frame, grids, k_grids, budget) -> tuple:
                                                          for gv, grid, p in zip(gvs, grids, priors)])
     weights = [a * gv.surface_area[:, None] for a, gv in zip(albedo, gvs)]
     k_m = (k_tr, k_albedo)
-    m_rho = cache.run("lpv_transfer_albedo", k_m, lambda: [
-        transfer.albedo_transfer(t, w) for t, w in zip(transfers, weights)])
-    return gvs, transfers, weights, m_rho, {"gv": k_gv, "transfer": k_tr, "albedo_transfer": k_m}
+    reflection = cache.run("lpv_transfer_albedo", k_m, lambda: [
+        transfer.bounded_transport(t, transfer.albedo_transfer(t, w), w) for t, w in zip(transfers, weights)])
+    return gvs, transfers, weights, reflection, {"gv": k_gv, "transfer": k_tr, "albedo_transfer": k_m}
 
 
 def skipped_work(stats: list, s) -> list:
@@ -187,11 +187,11 @@ def _build(ctx, programs, gv, grid, budget, s, prior=None) -> transfer.Transfer:
     return transfer.sort_by_cluster(sources, matrix, gv, grid)
 
 
-def _solve(ctx, gvs, grids, transfers, m_rho, sources, s) -> dict:
+def _solve(ctx, gvs, grids, transfers, reflection, sources, s) -> dict:
     """Each cascade's bounce series (transfer.solve), uploaded for the flux lookup, and its statistics."""
     surfaces, stats = [], []
-    for gv, grid, t, m, (first, unbinned) in zip(gvs, grids, transfers, m_rho, sources):
-        sides, passes = transfer.solve(t, m, first, s.bounces, s.epsilon)
+    for gv, grid, t, (m, gain), (first, unbinned) in zip(gvs, grids, transfers, reflection, sources):
+        sides, passes = transfer.solve(t, m, first, s.bounces, s.epsilon, gain)
         valid = (gv.surface_area > 0) & (np.linalg.norm(gv.surface_normal, axis=1) > 0)
         surfaces.append(transfer.upload_sides(ctx, grid, gv.fine, gv.cells, valid, sides))
         stats.append({"cells": list(grid.size), "cell": grid.cell, "transport": "transfer",

@@ -146,8 +146,6 @@ class Transfer:
     normals: np.ndarray = None
     areas: np.ndarray = None
     updated: float = 1.0  # the share of T evaluated when it was made (1: all of it; less after an edit)
-    gain: np.ndarray | None = None  # (C,) what each cluster's flux is scaled by before T: conserving_gain
-
 
     @property
     def nbytes(self) -> int:
@@ -168,21 +166,42 @@ def sort_by_cluster(clusters: Clusters, matrix: np.ndarray, gv=None, grid: Grid 
         starts.append(np.searchsorted(key[perm], np.arange(clusters.count + 1)))
     if gv is None:
         return Transfer(clusters, out, order, starts, updated=updated)
-    gain = conserving_gain(matrix, gv.surface_area)
     return Transfer(clusters, out, order, starts, grid, gv.cells.copy(), gv.surface_normal.copy(),
-                    gv.surface_area.copy(), updated, gain)
+                    gv.surface_area.copy(), updated)
 
 
-def conserving_gain(matrix: np.ndarray, areas: np.ndarray) -> np.ndarray:
-    """(C,) ≤ 1: the factor that keeps what one watt of cluster c delivers to all receivers together,
-    P_c = Σ_sides Σ_r T[side, c, r]·area_r, at most one watt. P_c ≤ 1 holds for the exact kernel (light leaving
-    a surface lands once, or leaves the scene); the voxel kernel breaks it where a slab thinner than a voxel puts
-    its two faces' voxels within END_CELLS of each other (lpv/gather.glsl: the crossing at a receiver's own end is
-    not counted), so the back side of the far face's voxel — inside the slab — receives the light its near face
-    did, and reflects it again: each bounce then grows (P_c up to 2.5 behind 2 cm walls), the series diverges.
-    Scaling such a cluster's flux to deliver one watt bounds every bounce by the albedo."""
-    delivered = sum(matrix[side].astype(np.float64) @ np.asarray(areas, np.float64) for side in range(2))
-    return np.where(delivered > 1.0, 1.0 / np.maximum(delivered, 1e-30), 1.0)
+def spectral_radius(m: np.ndarray, iterations: int = 100) -> float:
+    """The largest |eigenvalue| of a non-negative square matrix, by power iteration from the all-ones vector."""
+    v = np.ones(m.shape[1])
+    r = 0.0
+    for _ in range(iterations):
+        w = m @ v
+        norm = float(np.linalg.norm(w))
+        if norm == 0.0:
+            return 0.0
+        r, v = norm / float(np.linalg.norm(v)), w / norm
+    return r
+
+
+def bounded_transport(t: Transfer, m_rho: np.ndarray, weight: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
+    """(M_ρ, gain): M_ρ as it is and no gain where the reflection can be physical, else every cluster's flux capped
+    so that it delivers at most one watt per watt (gain (C,) ≤ 1, folded into M_ρ's columns; solve applies it to T).
+
+    The exact operator has spectral radius r ≤ ρ_max, the brightest receiver's albedo: a cluster's watt lands at
+    most once, and a receiver reflects at most ρ_max of it. The voxel kernel breaks that where a slab thinner than
+    a voxel puts its two faces' voxels within END_CELLS of each other (lpv/gather.glsl: the crossing at a receiver's
+    own end is not counted): the back side of the far face's voxel, inside the slab, receives the light its near
+    face did and reflects it again. Behind 2 cm walls clusters delivered up to 2.5 W per watt, r reached 1.5 ρ_max,
+    and every bounce grew. In the other example rooms r stays below ρ_max (0.67–0.99 of it) although single clusters
+    scatter around one watt (0.8 to 1.4): capping those would darken them (furnished's Combined 0.10 → 0.14), so
+    the cap applies only where r shows the operator is impossible."""
+    rho = (np.asarray(weight, np.float64) / np.maximum(np.asarray(t.areas, np.float64)[:, None], 1e-30)).max(axis=0)
+    if all(spectral_radius(m_rho[ch]) <= rho[ch] for ch in range(m_rho.shape[0])):
+        return m_rho, None
+    delivered = sum(t.matrix[side].astype(np.float64) @ np.asarray(t.areas, np.float64)[t.order[side]]
+                    for side in range(2))
+    gain = np.where(delivered > 1.0, 1.0 / np.maximum(delivered, 1e-30), 1.0)
+    return m_rho * gain[None, None, :], gain
 
 
 def albedo_transfer(t: Transfer, weight: np.ndarray) -> np.ndarray:
@@ -201,25 +220,24 @@ def albedo_transfer(t: Transfer, weight: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(out.transpose(2, 0, 1), np.float64)
 
 
-def solve(t: Transfer, m_rho: np.ndarray, first: np.ndarray, bounces: int, epsilon: float
-          ) -> tuple[np.ndarray, list]:
+def solve(t: Transfer, m_rho: np.ndarray, first: np.ndarray, bounces: int, epsilon: float,
+          gain: np.ndarray | None = None) -> tuple[np.ndarray, list]:
     """Irradiance summed over `bounces` passes, (2, R, 3) per side: T × the sources' flux summed over passes —
-    `first` (C, 3) from the RSM, each further pass's the reflection of the one before (M_ρ), every pass's flux
-    scaled by t.gain (conserving_gain) where T carries it. Stops once a pass's flux is below `epsilon` of the
-    largest so far. Returns the totals and, per pass, its source flux."""
-    gain = 1.0 if t.gain is None else t.gain[:, None]  # conserving_gain: the flux T and M_ρ carry
+    `first` (C, 3) from the RSM, each further pass's the reflection of the one before (M_ρ), each cluster's flux
+    times `gain` where T carries it (bounded_transport; M_ρ has it folded in). Stops once a pass's flux is below
+    `epsilon` of the largest so far. Returns the totals and, per pass, its source flux."""
     phi = np.asarray(first, np.float64)
     total = phi.copy()
     passes = [float(phi.sum())]
-    following = np.einsum("kij,jk->ik", m_rho, phi * gain)
+    following = np.einsum("kij,jk->ik", m_rho, phi)
     for _ in range(2, bounces + 1):
         phi = following
         passes.append(float(phi.sum()))
         total += phi
         if passes[-1] <= epsilon * max(passes):
             break
-        following = np.einsum("kij,jk->ik", m_rho, phi * gain)
-    sums = (total * gain).T.astype(np.float32)  # (3, C)
+        following = np.einsum("kij,jk->ik", m_rho, phi)
+    sums = (total if gain is None else total * gain[:, None]).T.astype(np.float32)  # (3, C)
     out = np.empty((2, t.matrix.shape[2], 3), np.float32)
     for side in range(2):
         out[side, t.order[side]] = (sums @ t.matrix[side]).T
