@@ -31,6 +31,10 @@ from . import emitters as em
 from ..scene import Light, Scene
 
 LIGHT_SUN, LIGHT_POINT, LIGHT_SPOT, LIGHT_POLYGON, LIGHT_SKY = 0, 1, 2, 3, 4
+# VCT's voxel injection (vct/inject.py) shadows the sky from every SKY_INJECTION_STRIDE-th direction, pixels from all:
+# the subset still spans the sphere (its cosine integral within 1-2%), the visibility is a ratio of weighted sums
+# (exact where the sky is unoccluded), and a voxel's light is averaged and bounced before a pixel shows it.
+SKY_INJECTION_STRIDE = 4
 
 LIGHT_DTYPE = np.dtype([("color_type", "<f4", 4), ("position", "<f4", 4), ("direction", "<f4", 4),
                         ("params", "<f4", 4), ("polygon", "<f4", 4)])

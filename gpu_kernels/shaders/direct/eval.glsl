@@ -15,6 +15,9 @@ uniform vec2 u_atlas_texel;        // 1 / atlas size
 // count as shadowed, since that light is trapped inside and the voxels would let it out (common/emitters.py).
 // The Diffuse Direct pass leaves it false and lights the inside exactly.
 uniform bool u_exclude_trapped;
+// Every u_sky_stride-th direction of the sky is read: 1 for pixels, common/lights.SKY_INJECTION_STRIDE for the
+// voxels' injection.
+uniform int u_sky_stride;
 
 // Visibility of world point p from one shadow view with a normal-offset bias and percentage-closer filtering.
 // The offset grows with the shadow texel's world footprint, which removes acne without a hand-tuned constant.
@@ -117,7 +120,7 @@ vec2 sky_shares(GpuLight L, vec3 p, vec3 n, vec3 geo_n, vec3 r, float alpha, boo
     int first = int(L.params.y);
     float kappa = 1.0 / (4.0 * alpha * alpha + 4.0 * PI / float(samples));
     vec2 wsum = vec2(0.0), vsum = vec2(0.0);
-    for (int k = 0; k < samples; ++k) {
+    for (int k = 0; k < samples; k += max(u_sky_stride, 1)) {
         vec3 d = shadow_views[first + k].emitter.xyz;
         // Directions below the surface see its back; grazing ones (cos < 0.1: 1% of the irradiance) would need
         // an offset larger than a thin wall is thick, so they take the others' mean (left out of both sums).
