@@ -195,10 +195,11 @@ def bounded_transport(t: Transfer, m_rho: np.ndarray, weight: np.ndarray) -> tup
     and every bounce grew. In the other example rooms r stays below ρ_max (0.67–0.99 of it) although single clusters
     scatter around one watt (0.8 to 1.4): capping those would darken them (furnished's Combined 0.10 → 0.14), so
     the cap applies only where r shows the operator is impossible."""
-    rho = (np.asarray(weight, np.float64) / np.maximum(np.asarray(t.areas, np.float64)[:, None], 1e-30)).max(axis=0)
+    areas = np.asarray(t.areas, np.float64)
+    rho = (np.asarray(weight, np.float64) / np.maximum(areas[:, None], 1e-30)).max(axis=0, initial=0.0)
     if all(spectral_radius(m_rho[ch]) <= rho[ch] for ch in range(m_rho.shape[0])):
         return m_rho, None
-    delivered = sum(t.matrix[side].astype(np.float64) @ np.asarray(t.areas, np.float64)[t.order[side]]
+    delivered = sum(t.matrix[side].astype(np.float64) @ areas[t.order[side]]
                     for side in range(2))
     gain = np.where(delivered > 1.0, 1.0 / np.maximum(delivered, 1e-30), 1.0)
     return m_rho * gain[None, None, :], gain
