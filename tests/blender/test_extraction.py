@@ -6,14 +6,12 @@ pytest process. The subprocess builds example scenes, extracts them with `extrac
 quantities independently through bpy (evaluated meshes, object instances, light data) and writes a JSON summary.
 Each experiment is recorded separately: one that raises stores its traceback, and only the tests that need it fail.
 """
-import json
 import os
-import subprocess
-import sys
-import tempfile
 
 import numpy as np
 import pytest
+
+from support.bpy_summary import run_summary
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 PROBE = os.path.join(ROOT, "tests", "support", "extraction_probe.py")  # the bpy side, run in the subprocess
@@ -33,19 +31,7 @@ EXTRACTION_TRIS = BLOB_TRIS + PROPS_INSTANCES * (CONE_TRIS + CYLINDER_TRIS) + PL
 
 @pytest.fixture(scope="module")
 def data():
-    import importlib.util
-
-    if importlib.util.find_spec("bpy") is None:
-        pytest.skip("bpy not installed in this interpreter")
-    with tempfile.TemporaryDirectory() as tmp:
-        out = os.path.join(tmp, "summary.json")
-        env = {**os.environ, "BLENDER_USER_RESOURCES": os.path.join(tmp, "blender_user"),
-               "BOUNCE_GI_CACHE": os.path.join(tmp, "cache")}
-        proc = subprocess.run([sys.executable, PROBE, out],
-                              capture_output=True, text=True, timeout=300, cwd=ROOT, env=env)
-        assert proc.returncode == 0, f"exit {proc.returncode}\n{proc.stdout[-4000:]}\n{proc.stderr[-4000:]}"
-        with open(out) as f:
-            return json.load(f)
+    return run_summary(PROBE, lambda out, tmp: [out], ROOT, {"BOUNCE_GI_CACHE": os.path.join("{tmp}", "cache")})
 
 
 def get(data, key):
