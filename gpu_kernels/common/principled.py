@@ -155,7 +155,29 @@ def metal_albedo(base, metal_weight, e, e_avg, s5) -> np.ndarray:
 
 def diffuse_mean(mat) -> np.ndarray:
     """rgb: the cosine-weighted average over view directions of D, 2∫D(μ)μ dμ — the share of the base colour a
-    surface reflects diffusely in all, which is what a voxel (no view direction) keeps of it."""
+    surface reflects diffusely in all."""
+    return transport_albedo(mat)[2]
+
+
+def transport_albedo(mat) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(scale, offset, diffuse) rgb: what a surface reflects of the light reaching it, with no view direction (a
+    voxel, a shadow-map texel), as base ⊙ scale + offset, cosine-weighted over directions (2∫…μ dμ); `diffuse` is
+    the diffuse base's part of `scale` (diffuse_mean).
+
+    The glossy closures count too: in Cycles the light a glossy layer reflects goes on to light other surfaces,
+    and their Diffuse Indirect holds it (a wall's 4 % specular reflection, a metal's whole reflection). A voxel
+    cannot keep the lobe's direction, so that flux leaves it diffusely; the energy, which is what the bounce
+    series compounds, is kept. The metal's albedo mix(F0, 1, s5) is linear in F0 = the base colour but for the
+    multiscatter darkening, evaluated at the material's own base colour (exact where no texture drives it)."""
     mu = (np.arange(64) + 0.5) / 64
-    d = layer_factors(mat, mu)[0]
-    return 2.0 * (d * mu[:, None]).mean(axis=0)
+    d, g, m, e, e_avg, s5, _ = layer_factors(mat, mu)
+    w = 2.0 * mu[:, None] / len(mu)  # the cosine-weighted mean as a sum over the midpoints
+    diffuse = (d * w).sum(axis=0)
+    offset = (g * w).sum(axis=0)
+    scale = diffuse.copy()
+    if np.any(m > 0.0):
+        f0 = np.clip(np.asarray(mat.base_color[:3], np.float64), 0.0, 1.0)
+        dark = _multiscatter_darkening(e, e_avg, f0 + (1.0 - f0) / 21.0) * m
+        scale = scale + (dark * (1.0 - s5)[:, None] * w).sum(axis=0)
+        offset = offset + (dark * s5[:, None] * w).sum(axis=0)
+    return scale, offset, diffuse

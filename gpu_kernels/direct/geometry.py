@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..common.principled import diffuse_mean, material_lut
+from ..common.principled import material_lut, transport_albedo
 from ..gl.bind import set_uniform
 from ..scene import Scene
 
@@ -52,10 +52,11 @@ def upload_geometry(ctx, programs, scene: Scene) -> GeometryBuffers:
 
 class MaterialTextures:
     """What the material uniforms sample: the scene's images (indexable like Scene.textures) and the materials'
-    Principled table (common/principled.py: material_lut) with the per-material view-averaged diffuse share."""
+    Principled table (common/principled.py: material_lut) with each material's transport albedo terms
+    (principled.transport_albedo: (scale, offset) rows, (M, 2, 3))."""
 
-    def __init__(self, images: list, lut, diffuse_means: np.ndarray):
-        self.images, self.lut, self.diffuse_means = images, lut, diffuse_means
+    def __init__(self, images: list, lut, transport: np.ndarray):
+        self.images, self.lut, self.transport = images, lut, transport
 
     def __len__(self):
         return len(self.images)
@@ -86,8 +87,8 @@ def upload_textures(ctx, scene: Scene) -> MaterialTextures:
     lut = ctx.texture((lut_rows.shape[1], lut_rows.shape[0]), 4, np.ascontiguousarray(lut_rows).tobytes(), dtype="f4")
     lut.filter = (moderngl.LINEAR, moderngl.LINEAR)
     lut.repeat_x = lut.repeat_y = False
-    means = np.array([diffuse_mean(m) for m in scene.materials] or [(1.0, 1.0, 1.0)], np.float32)
-    return MaterialTextures(out, lut, means)
+    terms = np.array([transport_albedo(m)[:2] for m in scene.materials] or [((1.0,) * 3, (0.0,) * 3)], np.float32)
+    return MaterialTextures(out, lut, terms)
 
 
 def bind_material(prog, scene: Scene, mat_index: int, textures: MaterialTextures) -> None:
@@ -97,7 +98,9 @@ def bind_material(prog, scene: Scene, mat_index: int, textures: MaterialTextures
     set_uniform(prog, "u_base_color", tuple(float(c) for c in base[:3]))
     set_uniform(prog, "u_roughness", float(mat.roughness) if mat else 0.5)
     set_uniform(prog, "u_material", mat_index if mat else 0)
-    set_uniform(prog, "u_diffuse_mean", tuple(float(c) for c in textures.diffuse_means[mat_index if mat else 0]))
+    scale, offset = textures.transport[mat_index if mat else 0]
+    set_uniform(prog, "u_albedo_scale", tuple(float(c) for c in scale))
+    set_uniform(prog, "u_albedo_offset", tuple(float(c) for c in offset))
     if "u_material_lut" in prog:
         textures.lut.use(location=LUT_UNIT)
         set_uniform(prog, "u_material_lut", LUT_UNIT)

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..common.grid import Grid
+from ..common.principled import transport_albedo
 from ..direct.geometry import bind_material
 from ..gl import preprocessor as spp
 from ..gl.bind import bind_images, bind_named, dispatch, set_uniform, set_uniforms
@@ -41,7 +42,7 @@ class VoxelVolumes:
     """RGBA32F 3D textures of size grid.size (x, y, z); see voxel/resolve.glsl for the channels.
 
     area: rgb = projected area onto the x/y/z planes (m²), a = surface area (m²);
-    albedo: rgb = area-weighted mean diffuse albedo, a = opacity = min(1, max projected area / cell²);
+    albedo: rgb = area-weighted mean albedo (voxel_albedo: diffuse and glossy reflectance), a = opacity = min(1, max projected area / cell²);
     normal: xyz = area-weighted mean sign-canonicalised geometric normal (not renormalised), w = 0;
     emission: rgb = area-weighted mean emitted radiance.
     """
@@ -154,7 +155,8 @@ def scene_area(scene: Scene) -> float:
 
 
 def material_maxima(scene: Scene, used) -> tuple[float, float]:
-    """Largest diffuse albedo and emission component over the materials in `used` (fixed-point normalisers)."""
+    """Largest voxel albedo (voxel/common.glsl voxel_albedo) and emission component over the materials in `used`
+    (fixed-point normalisers)."""
     albedo, emission = 0.0, 0.0
     for i in used:
         mat = scene.materials[i] if 0 <= i < len(scene.materials) else None
@@ -165,7 +167,8 @@ def material_maxima(scene: Scene, used) -> tuple[float, float]:
             color = float(np.max(scene.textures[mat.base_color_texture].pixels[..., :3], initial=0.0))
         else:
             color = max(float(c) for c in mat.base_color[:3])
-        albedo = max(albedo, color * (1.0 - min(max(float(mat.metallic), 0.0), 1.0)))
+        scale, offset, _ = transport_albedo(mat)
+        albedo = max(albedo, float(np.max(max(color, 0.0) * scale + offset)))
         emission = max(emission, max(float(c) for c in mat.emission[:3]))
     return (albedo if albedo > 0 else 1.0), (emission if emission > 0 else 0.0)
 

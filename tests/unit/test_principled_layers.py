@@ -98,3 +98,43 @@ def test_diffuse_bsdf_and_lut_layout():
     assert np.allclose(lut[0, :, :3], 1.0) and np.allclose(lut[1, :, :3], 0.0)  # Lambertian, no glossy
     assert np.allclose(principled.diffuse_mean(mats[0]), 1.0)
     assert 0.9 < principled.diffuse_mean(mats[1])[0] < 0.97
+
+
+def _total_albedo(mat, base):
+    scale, offset, _ = principled.transport_albedo(mat)
+    return np.asarray(base, np.float64) * scale + offset
+
+
+@pytest.mark.parametrize("roughness", (0.0, 0.5, 1.0))
+@pytest.mark.parametrize("level", (0.0, 0.5, 1.0))
+def test_transport_albedo_of_a_white_dielectric_is_one(roughness, level):
+    """Cycles' layering gives the diffuse base what the specular layer leaves (weight 1 − A(μ)), so a white
+    Principled dielectric reflects everything, whatever its roughness and Specular IOR Level: diffuse + glossy = 1
+    at every μ, hence in the cosine-weighted mean (to the midpoint sums' rounding, 1e-9)."""
+    mat = principled_material(base_color=(1.0, 1.0, 1.0), roughness=roughness, specular_ior_level=level)
+    assert np.allclose(_total_albedo(mat, (1.0, 1.0, 1.0)), 1.0, atol=1e-9)
+
+
+def test_transport_albedo_counts_the_glossy_layer():
+    """A grey wall (Specular IOR Level 0.5, IOR 1.5: F0 = 4 %) reflects more than its diffuse share: the glossy
+    layer's cosine-weighted albedo is at least F0 and at most Fresnel's hemispherical mean for η = 1.5 (about 9 %).
+    With Specular IOR Level 0 there is no layer: the base colour, all of it diffuse."""
+    mat = principled_material(base_color=(0.5, 0.5, 0.5), roughness=0.5)
+    scale, offset, diffuse = principled.transport_albedo(mat)
+    assert np.allclose(scale, diffuse) and 0.04 <= offset[0] <= principled.dielectric_fss(1.5)
+    plain = principled_material(base_color=(0.5, 0.5, 0.5), roughness=0.5, specular_ior_level=0.0)
+    assert np.allclose(_total_albedo(plain, (0.5, 0.5, 0.5)), 0.5, atol=1e-9)
+    assert np.allclose(principled.transport_albedo(Material("diffuse"))[:2], ((1, 1, 1), (0, 0, 0)))
+
+
+@pytest.mark.parametrize("roughness", (0.0, 0.3, 0.8))
+def test_transport_albedo_of_a_metal_is_its_glossy_colour_averaged(roughness):
+    """metallic 1: no diffuse share; the total is the metal's Glossy Color (principled.metal_albedo, the shader's
+    twin) averaged over μ with the cosine weight, to the quadrature's resolution (64 vs 4096 midpoints: 1e-4)."""
+    base = (0.9, 0.6, 0.3)
+    mat = principled_material(base_color=base, roughness=roughness, metallic=1.0)
+    mu = (np.arange(4096) + 0.5) / 4096
+    _, _, m, e, e_avg, s5, _ = principled.layer_factors(mat, mu)
+    expected = 2.0 * (principled.metal_albedo(base, m, e, e_avg, s5) * mu[:, None]).mean(axis=0)
+    assert np.allclose(principled.transport_albedo(mat)[2], 0.0)
+    assert np.allclose(_total_albedo(mat, base), expected, atol=1e-4)

@@ -37,7 +37,7 @@ uniform vec3 u_grid_origin;
 uniform float u_grid_cell;
 uniform int u_light_count;
 uniform sampler3D u_area;        // voxelize(): rgb projected areas (m²), a total area
-uniform sampler3D u_albedo;      // rgb mean diffuse albedo
+uniform sampler3D u_albedo;      // rgb mean albedo (voxel/common.glsl voxel_albedo)
 uniform usampler3D u_acc;        // vct/inject_raster.glsl's sums (float bits)
 // Six images per dispatch, not twelve: NVIDIA drivers allow 8 image units per stage (GL_MAX_IMAGE_UNITS, the
 // spec's minimum; Mesa allows 32), so vct.inject() runs this twice — faces, then centroids (WRITE_CENTROIDS).

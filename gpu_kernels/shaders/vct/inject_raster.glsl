@@ -4,8 +4,8 @@
 //
 // Geometry shader: each triangle is projected along the dominant axis of its normal (Freed 2018, §4.1.1, Algorithm 1)
 // onto a plane of VCT_SAMPLES pixels per voxel edge; every fragment is a point p on the surface, with the
-// triangle's geometric normal n and its material's diffuse albedo (base colour or texture × (1 − metallic), as the
-// voxelizer defines it).
+// triangle's geometric normal n and its material's albedo as the voxelizer defines it (voxel/common.glsl
+// voxel_albedo: the diffuse and glossy layers' reflectance averaged over directions).
 // Fragment shader: for each side s = ±n the outgoing radiance L_s = albedo·E(p, s·n)/π, E the shadowed irradiance
 // of every light exactly as the Diffuse Direct pass computes it (direct/eval.glsl), less the light closed emitters
 // trap inside themselves (u_exclude_trapped; common/emitters.py). The side's light leaves the
@@ -80,7 +80,8 @@ uniform float u_grid_cell;
 uniform ivec3 u_grid_size;
 uniform int u_light_count;
 uniform vec3 u_base_color;
-uniform vec3 u_diffuse_mean;      // common/principled.py: diffuse_mean (the layers above the diffuse base)
+uniform vec3 u_albedo_scale;      // common/principled.py: transport_albedo, albedo = base ⊙ scale + offset
+uniform vec3 u_albedo_offset;
 uniform bool u_use_texture;
 uniform sampler2D u_base_texture;
 in vec3 g_world;
@@ -138,7 +139,7 @@ void main() {
     return;
 #endif
     vec3 color = u_use_texture ? textureLod(u_base_texture, g_uv, 0.0).rgb : u_base_color;
-    vec3 albedo = max(color, vec3(0.0)) * u_diffuse_mean;
+    vec3 albedo = max(color, vec3(0.0)) * u_albedo_scale + u_albedo_offset;
     for (int side = 0; side < 2; ++side) {
         vec3 n = side == 0 ? g_normal : -g_normal;
         vec3 e = vec3(0.0);

@@ -16,7 +16,8 @@
 #pragma once
 
 uniform vec3 u_base_color;       // linear RGB, the diffuse albedo when no texture
-uniform vec3 u_diffuse_mean;     // common/principled.py: diffuse_mean (the layers above the diffuse base)
+uniform vec3 u_albedo_scale;     // common/principled.py: transport_albedo, albedo = base ⊙ scale + offset
+uniform vec3 u_albedo_offset;
 uniform vec3 u_emission;         // emission colour × strength
 uniform bool u_use_texture;
 uniform sampler2D u_base_texture;
@@ -31,11 +32,12 @@ layout(binding = 3, r32ui) uniform uimage3D u_acc_emission;
 layout(binding = 4, r32ui) uniform uimage3D u_flags;   // 1×1×1; bit 0 set when an area sum wrapped
 uniform ivec3 u_grid_size;            // grid size (nx, ny, nz)
 
-// Diffuse albedo of a voxel surfel: base colour (or texture) × the diffuse base's share averaged over view
-// directions (cosine-weighted): the layers above take a view-dependent part, and a voxel has no view direction.
+// Albedo of a voxel surfel: what the surface reflects of the light reaching it, averaged over directions
+// (cosine-weighted), its glossy layers' share included (common/principled.py: transport_albedo): a voxel has no
+// view direction, so the glossy reflection leaves it diffusely.
 vec3 voxel_albedo(vec2 uv) {
     vec3 color = u_use_texture ? textureLod(u_base_texture, uv, 0.0).rgb : u_base_color;
-    return max(color, vec3(0.0)) * u_diffuse_mean;
+    return max(color, vec3(0.0)) * u_albedo_scale + u_albedo_offset;
 }
 
 // Two-sided surfaces: flip a normal so its largest-magnitude component is positive (ties: first axis wins).
