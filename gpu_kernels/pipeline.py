@@ -6,7 +6,9 @@ Passes and their inputs (a pass re-runs only when one of its inputs changed — 
     textures      ← materials (images)
     emitter_shells← geometry, materials (closed emitters: common/emitters.py)
     shadow_maps   ← geometry, materials (emissive triangles), lights, shadow settings, which closed emitters hold
-                    the camera
+                    the camera, world
+      shadow_depth← geometry, the shadow views (their depth atlas: a light's power or the world's colour
+                    moves no view, so it is kept)
     gbuffer       ← geometry, materials, camera, resolution
     direct_light  ← gbuffer, shadow_maps
     <method>      ← the above (lpv/passes.py, vct/passes.py: the indirect light)
@@ -240,9 +242,11 @@ class Pipeline:
         trapping = [s for k, s in enumerate(shells) if k not in around]
         keys["shadow"] = (keys["geometry"], keys["materials"], keys["lights"], keys["world"], repr(settings.shadow),
                          around)
-        shadows = cache.run("shadow_maps", keys["shadow"],
-                            lambda: sh.render_shadow_atlas(ctx, programs, scene, geometry, settings.shadow,
-                                                           trapping))
+        # The depth atlas is a pass of its own, keyed by the views it draws: a light's power or colour and the
+        # world's change the records, not the maps (384 of them for the sky).
+        shadows = cache.run("shadow_maps", keys["shadow"], lambda: sh.render_shadow_atlas(
+            ctx, programs, scene, geometry, settings.shadow, trapping,
+            depth_pass=lambda key, render: cache.run("shadow_depth", (keys["geometry"], key), render)))
         keys["gbuffer"] = (keys["geometry"], keys["materials"], keys["camera"])
         if samples is None:
             gbuffer = cache.run("gbuffer", keys["gbuffer"], lambda: gb.render_gbuffer(

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 from ..common import lights as lb
 from ..gl.bind import set_uniform, ssbo, write_uniform
-from ..scene import Scene
+from ..scene import Scene, hash_parts
 from .geometry import GeometryBuffers
 
 
@@ -22,42 +22,62 @@ class ShadowAtlas:
     view_count: int
     warnings: list
     buffers: lb.LightBuffers  # the CPU-side records (RSMs reuse the views)
+    owns_depth: bool = True  # False where the depth atlas is cached apart (render_shadow_atlas's depth_pass)
 
     def release(self):
-        for obj in (self.depth, self.light_ssbo, self.view_ssbo, self.polygon_ssbo):
+        for obj in (self.light_ssbo, self.view_ssbo, self.polygon_ssbo) + ((self.depth,) if self.owns_depth else ()):
             obj.release()
 
 
 def render_shadow_atlas(ctx, programs, scene: Scene, geometry: GeometryBuffers,
-                        settings: lb.ShadowSettings, trapping: list | None = None) -> ShadowAtlas:
+                        settings: lb.ShadowSettings, trapping: list | None = None, depth_pass=None) -> ShadowAtlas:
     """Render every light's shadow views into one depth atlas and upload the light/view/polygon buffers.
-    `trapping`: the closed emitters whose inner light is trapped (common/emitters.trapping_shells)."""
-    import moderngl
-
+    `trapping`: the closed emitters whose inner light is trapped (common/emitters.trapping_shells).
+    `depth_pass(key, render)`: where the depth atlas is cached apart (the pipeline's 'shadow_depth' pass), keyed by
+    `depth_key` of the views; a light's power or colour, or the world's, moves no view, so such an edit renders no
+    depth. None: rendered here, and the atlas owns it."""
     buffers = lb.build_light_buffers(scene, settings, trapping)
     max_size = ctx.info.get("GL_MAX_TEXTURE_SIZE", 16384)
     tiles, size, scale = lb.allocate_atlas([v.resolution for v in buffers.views], max_height=max_size)
     warnings = list(buffers.warnings)
     if scale > 1:
         warnings.append(f"shadow maps reduced {scale}x to fit the atlas ({len(buffers.views)} views)")
+
+    def render():
+        return render_depth(ctx, programs, geometry, buffers.views, tiles, size)
+
+    depth = render() if depth_pass is None else depth_pass(depth_key(buffers.views, tiles, size), render)
+    views = lb.pack_views(buffers.views, tiles, size, settings.pcf_radius, buffers.view_lights)
+    return ShadowAtlas(depth, size, ssbo(ctx, buffers.lights), ssbo(ctx, views), ssbo(ctx, buffers.polygon_vertices),
+                       len(buffers.lights), len(buffers.views), warnings, buffers, owns_depth=depth_pass is None)
+
+
+def depth_key(views: list, tiles: list, size: tuple) -> str:
+    """What the depth atlas is drawn from besides the geometry: each view's projection, eye and depth range, and
+    where its tile lies."""
+    return hash_parts([(v.view_projection, v.origin, v.far) for v in views], [tuple(t) for t in tiles], tuple(size))
+
+
+def render_depth(ctx, programs, geometry: GeometryBuffers, views: list, tiles: list, size: tuple):
+    """The depth atlas: every view drawn into its tile (direct/shadow_depth.glsl), comparison enabled."""
+    import moderngl
+
     depth = ctx.depth_texture(size)
     depth.compare_func = "<="
     depth.filter = (moderngl.LINEAR, moderngl.LINEAR)
     depth.repeat_x = depth.repeat_y = False
-    if buffers.views:
+    if views:
         fbo = ctx.framebuffer(depth_attachment=depth)
         fbo.use()
         fbo.clear(depth=1.0)
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.disable(moderngl.CULL_FACE)
         prog = programs.raster("direct/shadow_depth.glsl")
-        for view, (x, y, w, h) in zip(buffers.views, tiles):
+        for view, (x, y, w, h) in zip(views, tiles):
             fbo.viewport = (x, y, w, h)
             write_uniform(prog, "u_view_projection", view.view_projection.T)
             set_uniform(prog, "u_origin", tuple(float(c) for c in view.origin))
             set_uniform(prog, "u_far", float(view.far))
             geometry.vao_depth.render(moderngl.TRIANGLES)
         fbo.release()
-    views = lb.pack_views(buffers.views, tiles, size, settings.pcf_radius, buffers.view_lights)
-    return ShadowAtlas(depth, size, ssbo(ctx, buffers.lights), ssbo(ctx, views), ssbo(ctx, buffers.polygon_vertices),
-                       len(buffers.lights), len(buffers.views), warnings, buffers)
+    return depth

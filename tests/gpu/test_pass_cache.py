@@ -110,7 +110,8 @@ def test_downstream_keys_rerun_transitively():
 SUN_STRENGTH = 3.0
 FLOOR_ALBEDO = (0.5, 0.4, 0.3)
 BOX = (np.array([-0.5, -0.5, 0.0]), np.array([0.5, 0.5, 1.0]))
-ALL_PASSES = {"geometry", "textures", "emitter_shells", "shadow_maps", "gbuffer", "direct_light", "compose"}
+ALL_PASSES = {"geometry", "textures", "emitter_shells", "shadow_depth", "shadow_maps", "gbuffer", "direct_light",
+              "compose"}
 
 
 def _quad(a, b, c, d, normal):
@@ -241,9 +242,10 @@ def test_pipeline_reruns_only_what_changed(engine, settings):
     check_direct(first.passes, scene.lights[0], -30.0)
 
     # Same scene (rebuilt, equal content): every pass is skipped, timings 0, the same passes come back.
+    # (The depth atlas is asked for only when the shadow maps re-run.)
     second = engine.render(make_scene(sun(-30.0), cam1), settings)
-    assert set(second.skipped) == ALL_PASSES
-    assert all(second.timings[p] == 0.0 for p in ALL_PASSES)
+    assert set(second.skipped) == ALL_PASSES - {"shadow_depth"}
+    assert all(second.timings[p] == 0.0 for p in ALL_PASSES - {"shadow_depth"})
     for name, image in first.passes.items():
         np.testing.assert_array_equal(second.passes[name], image)
 
@@ -251,7 +253,7 @@ def test_pipeline_reruns_only_what_changed(engine, settings):
     moved = make_scene(sun(-50.0), cam1)
     third = engine.render(moved, settings)
     assert set(third.skipped) == {"geometry", "textures", "emitter_shells", "gbuffer"}
-    assert {"shadow_maps", "direct_light", "compose"}.isdisjoint(third.skipped)
+    assert {"shadow_depth", "shadow_maps", "direct_light", "compose"}.isdisjoint(third.skipped)
     check_direct(third.passes, moved.lights[0], -50.0)
     np.testing.assert_array_equal(third.passes["Position"], first.passes["Position"])
 
@@ -269,6 +271,28 @@ def test_pipeline_reruns_only_what_changed(engine, settings):
     world.world.color = (0.1, 0.2, 0.3)
     fifth = engine.render(world, settings)
     assert set(fifth.skipped) == {"geometry", "textures", "emitter_shells", "gbuffer"}
+
+    # Another world colour, and then a brighter sun: the lights' records change, no shadow view does, so the
+    # depth atlas (the sky's 384 maps among them) is kept — and the image is what a cold render gives.
+    recoloured = make_scene(sun(-50.0), cam2)
+    recoloured.world.color = (0.3, 0.2, 0.1)
+    sixth = engine.render(recoloured, settings)
+    assert set(sixth.skipped) == {"geometry", "textures", "emitter_shells", "shadow_depth", "gbuffer"}
+    brighter = make_scene(sun(-50.0), cam2)
+    brighter.world.color = (0.3, 0.2, 0.1)
+    brighter.lights[0].power *= 2.0
+    seventh = engine.render(brighter, settings)
+    assert set(seventh.skipped) == {"geometry", "textures", "emitter_shells", "shadow_depth", "gbuffer"}
+    from bounce_gi.gpu_kernels.engine import Engine
+
+    cold_engine = Engine()
+    try:
+        for scene_, warm in ((recoloured, sixth), (brighter, seventh)):
+            cold = cold_engine.render(scene_, settings)
+            for name in ("Diffuse Direct", "Combined"):
+                np.testing.assert_array_equal(warm.passes[name], cold.passes[name])
+    finally:
+        cold_engine.shutdown()
 
 
 def test_a_pass_keeps_as_many_outputs_as_asked_and_releases_the_rest():
