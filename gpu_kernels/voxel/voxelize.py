@@ -23,7 +23,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..common.grid import Grid
-from ..common.principled import transport_albedo
 from ..direct.geometry import bind_material
 from ..gl import preprocessor as spp
 from ..gl.bind import bind_images, bind_named, dispatch, set_uniform, set_uniforms
@@ -75,12 +74,12 @@ class VoxelVolumes:
             tex.release()
 
 
-def voxelize(ctx, programs, scene: Scene, geometry, textures: list, grid: Grid, mode: str = "raster",
+def voxelize(ctx, programs, scene: Scene, geometry, textures, grid: Grid, mode: str = "raster",
              supersample: int = 2, scale_bits: int = DEFAULT_SCALE_BITS) -> VoxelVolumes:
     """Voxelise the scene's surfaces into `grid` (GL thread); returns new textures the caller releases.
 
     `geometry`: direct/geometry.GeometryBuffers of `scene` (raster draws its VBO; tessellation uploads its own patch
-    buffer with oversized triangles split, so only the material ranges are read). `textures`: the list from
+    buffer with oversized triangles split, so only the material ranges are read). `textures`: the MaterialTextures of
     direct/geometry.upload_textures. `supersample`: raster — pixels per voxel edge, i.e. texture samples per voxel face
     (areas are exact at any value); tessellation — sub-triangles per voxel edge. `scale_bits`: fixed-point
     fraction bits (1 unit = 2^-bits cell²); lowered automatically, and reported, if a voxel's sum would wrap.
@@ -91,7 +90,7 @@ def voxelize(ctx, programs, scene: Scene, geometry, textures: list, grid: Grid, 
     supersample = int(supersample)
     nx, ny, nz = grid.size
     used = sorted({m for m, _, _ in geometry.ranges})
-    albedo_max, emission_max = material_maxima(scene, used)
+    albedo_max, emission_max = material_maxima(scene, used, textures.transport)
     accs = [ctx.texture3d((4 * nx, ny, nz), 1, dtype="u4") for _ in range(4)]
     flags = ctx.texture3d((1, 1, 1), 1, np.zeros(1, np.uint32).tobytes(), dtype="u4")
     for t in accs + [flags]:
@@ -154,9 +153,9 @@ def scene_area(scene: Scene) -> float:
     return float(0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1).sum())
 
 
-def material_maxima(scene: Scene, used) -> tuple[float, float]:
+def material_maxima(scene: Scene, used, transport: np.ndarray) -> tuple[float, float]:
     """Largest voxel albedo (voxel/common.glsl voxel_albedo) and emission component over the materials in `used`
-    (fixed-point normalisers)."""
+    (fixed-point normalisers); `transport`: the materials' albedo terms (direct/geometry.MaterialTextures)."""
     albedo, emission = 0.0, 0.0
     for i in used:
         mat = scene.materials[i] if 0 <= i < len(scene.materials) else None
@@ -167,7 +166,7 @@ def material_maxima(scene: Scene, used) -> tuple[float, float]:
             color = float(np.max(scene.textures[mat.base_color_texture].pixels[..., :3], initial=0.0))
         else:
             color = max(float(c) for c in mat.base_color[:3])
-        scale, offset, _ = transport_albedo(mat)
+        scale, offset = transport[i]
         albedo = max(albedo, float(np.max(max(color, 0.0) * scale + offset)))
         emission = max(emission, max(float(c) for c in mat.emission[:3]))
     return (albedo if albedo > 0 else 1.0), (emission if emission > 0 else 0.0)
