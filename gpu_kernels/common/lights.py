@@ -80,6 +80,7 @@ class ShadowView:
     emit_normal: np.ndarray | None = None
     emit_share: float = 0.0
     pcf_radius: int | None = None  # this view's PCF radius, where not ShadowSettings.pcf_radius (the sky's: 0)
+    own_extent: float = 0.0  # tan(half angle) a cube face covers alone (1; lpv/inject.glsl cube_share), else 0
 
 
 @dataclass
@@ -168,8 +169,8 @@ def cube_views(origin, resolution: int, near: float, far: float, emit_normal=Non
     views = []
     for fwd, up in CUBE_DIRECTIONS:
         view = cam.look_at(origin, np.asarray(origin) + fwd, up)
-        views.append(ShadowView(proj @ view, np.asarray(origin, np.float64), False,
-                                2 * margin / resolution, resolution, far, view, margin, emit_normal, emit_share))
+        views.append(ShadowView(proj @ view, np.asarray(origin, np.float64), False, 2 * margin / resolution,
+                                resolution, far, view, margin, emit_normal, emit_share, own_extent=1.0))
     return views
 
 

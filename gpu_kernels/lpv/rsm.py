@@ -115,5 +115,5 @@ def render_rsm(ctx, programs, scene: Scene, geometry, textures, shadows, resolut
                                 2 * view.half_extent / w if view.ortho else 0.0, light, k)
         records[i]["origin"] = (*view.origin, 1.0 if view.ortho else 0.0)
         records[i]["axis"] = (*-back, float(w))  # w: texels per side of this view
-        records[i]["right"] = (*right, 0.0)
+        records[i]["right"] = (*right, view.own_extent)
     return Rsm(*targets, ssbo(ctx, records), size, resolution // scale, flux_bound(buffers), vao, fbo, depth)

@@ -23,7 +23,8 @@ struct RsmView {
     vec4 params;   // x: tan(half fov) (perspective) or 0; y: texel world size (orthographic); z: light; w: sample k
     vec4 origin;   // xyz eye (perspective); w: 1 if orthographic
     vec4 axis;     // xyz view axis; w: texels per side of this view (lpv/rsm.view_resolution)
-    vec4 right;    // xyz right vector of the view; w: unused (with axis and up: tangent-plane coordinates)
+    vec4 right;    // xyz right vector of the view (with axis and up: tangent-plane coordinates); w: the tangent
+                   // half extent the view covers alone (1 for a cube's face), 0 where it overlaps no other view
 };
 layout(std430, binding = 3) readonly buffer RsmViewBuffer { RsmView rsm_views[]; };
 #if defined(MODE_LIST)
@@ -41,6 +42,21 @@ float texel_solid_angle(RsmView v, vec3 p) {
     float x = dot(d, v.right.xyz) / z, y = dot(d, up) / z;
     float t = 2.0 * v.params.x / v.axis.w;
     return t * t / pow(1.0 + x * x + y * y, 1.5);
+}
+
+// The share of the texel at p that belongs to its view alone: a cube's faces are rendered a few texels wider
+// than 90° (common/lights.cube_views: PCF never reads past an edge), so near its edges a face sees what the next
+// face sees too. Those texels' flux would count twice (a closed room got 1.017 of a point light's power): each
+// texel keeps the part of its footprint, in tangent-plane coordinates, inside the face's own [−1, 1]².
+float cube_share(RsmView v, vec3 p) {
+    if (v.right.w <= 0.0) return 1.0;
+    vec3 d = p - v.origin.xyz;
+    float z = dot(d, v.axis.xyz);
+    vec3 up = cross(v.right.xyz, v.axis.xyz);
+    vec2 xy = abs(vec2(dot(d, v.right.xyz), dot(d, up)) / z);
+    float t = 2.0 * v.params.x / v.axis.w;  // a texel's tangent-plane width
+    vec2 inside = clamp((v.right.w - xy) / t + 0.5, 0.0, 1.0);
+    return inside.x * inside.y;
 }
 
 // Reflected flux of a surfel at p (normal n facing the light, albedo a) seen by RSM view v.
@@ -63,7 +79,7 @@ vec3 vpl_flux(RsmView v, vec3 p, vec3 n, vec3 albedo) {
         vec3 d = p - L.position.xyz;
         float d2 = dot(d, d);
         float att = type == LIGHT_SPOT ? spot_attenuation(L, normalize(d)) : 1.0;
-        return albedo * color * att * texel_solid_angle(v, p) * d2 / (d2 + L.position.w);
+        return albedo * color * att * texel_solid_angle(v, p) * cube_share(v, p) * d2 / (d2 + L.position.w);
     }
     // Polygon light seen from sample point k: this RSM carries the share w_k/Σw_j of the exact irradiance, where
     // w_j = A_j · cosθ_light,j · cosθ_surface,j / d_j² (the same weights as the shadow test, direct/eval.glsl).
@@ -83,7 +99,7 @@ vec3 vpl_flux(RsmView v, vec3 p, vec3 n, vec3 albedo) {
         if (j == k) share_k = cl;
     }
     if (wsum <= 0.0) return vec3(0.0);
-    return albedo * color * psa * share_k * texel_solid_angle(v, p) / wsum;
+    return albedo * color * psa * share_k * texel_solid_angle(v, p) * cube_share(v, p) / wsum;
 }
 
 void main() {
