@@ -4,14 +4,20 @@
   - latency from an edit (light move, material colour, object move) to each stage uploaded (direct light,
     draft GI, final GI), as ui/live.py's stats record it: what a user waits for after the edit;
   - main-thread time per update: the depsgraph handler (change set + extraction) and the upload of each stage;
-  - redraw cost at 960×540: our surface shader drawing a result, against Blender's builtin flat shader drawing
-    the same triangles (what Blender's own Solid drawing of those meshes costs at least), each timed with a
-    read-back so the GPU work is inside the measurement;
+  - redraw cost at 960×540 (and any --res): Rendered shading's redraw of the final result from the scene camera
+    (draw.draw_view3d, what view_draw does, into an RGBA16F framebuffer like the 3D view's), against Blender's
+    builtin flat shader drawing the same triangles into the same framebuffer (what Blender's own Solid drawing of
+    those meshes costs at least). The two alternate, round after round, so a load that comes and goes on the
+    machine falls on both; each redraw is timed up to a 1-pixel read-back, which waits for the GL to finish (on
+    llvmpipe a draw call only queues the work); the medians of 60 rounds after 5 of warm-up, and the median of
+    the rounds' differences;
   - F12 (the render engine, the scene camera, 160×120), with every pass run and again with the cache holding.
 
     .venv/bin/python benchmarks/viewport_bench.py [--method lpv|vct|none] [--scenes cornell spot_room courtyard]
+        [--res W H ...] [--redraw-only]
 
-Prints one table per scene and asserts nothing; results/viewport_llvmpipe.md holds a run on the 2-core dev box.
+--redraw-only computes the final stage once and times only the redraws. Prints one table per scene and asserts
+nothing; results/viewport_llvmpipe.md holds runs on the 2-core dev box.
 """
 import argparse
 import os
@@ -26,56 +32,73 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)  # examples/
 
 
-def timed_draws(fn, offscreen, repeats=7):
-    """Median seconds of fn() into `offscreen` with a 1-pixel read-back (so the GPU finished)."""
+def timed_rounds(draws: dict, target, rounds=60, warm_up=5) -> dict:
+    """name → seconds of each of `rounds` redraws into `target`, the draws alternating round after round, each
+    timed up to a 1-pixel read-back (so the GL finished)."""
     import gpu
 
-    out = []
-    for _ in range(repeats + 1):
-        start = time.perf_counter()
-        with offscreen.bind():
-            fn()
-            gpu.state.active_framebuffer_get().read_color(0, 0, 1, 1, 4, 0, "FLOAT")
-        out.append(time.perf_counter() - start)
-    return statistics.median(out[1:])
+    times = {name: [] for name in draws}
+    for r in range(warm_up + rounds):
+        for name, fn in draws.items():
+            start = time.perf_counter()
+            with target.bind():
+                fn()
+                gpu.state.active_framebuffer_get().read_color(0, 0, 1, 1, 4, 0, "FLOAT")
+            if r >= warm_up:
+                times[name].append(time.perf_counter() - start)
+    return times
 
 
-def redraw_costs(drawing, positions, world) -> tuple[float, float]:
-    """(ours, Blender's flat builtin shader) seconds to draw the same triangles at 960×540 from the scene camera."""
-    import bpy
+def flat_draw(positions, view):
+    """Blender's builtin UNIFORM_COLOR shader drawing `positions` (triangles) depth-tested and depth-writing, after
+    the same clear as ours."""
     import gpu
     from gpu_extras.batch import batch_for_shader
     from mathutils import Matrix
 
-    from bounce_gi.addon.extract.camera import read_camera
-    from bounce_gi.ui import draw
-
-    w, h = 960, 540
-    offscreen = gpu.types.GPUOffScreen(w, h, format="RGBA16F")
-    view = draw.camera_view(read_camera(bpy.context.scene), w, h)
-    ours = timed_draws(lambda: draw.draw_offscreen(drawing, offscreen, view, world), offscreen)
     flat = gpu.shader.from_builtin("UNIFORM_COLOR")
     batch = batch_for_shader(flat, "TRIS", {"pos": positions})
 
     def plain():
         gpu.state.active_framebuffer_get().clear(color=(0, 0, 0, 1), depth=1.0)
         gpu.state.depth_test_set("LESS_EQUAL")
+        gpu.state.depth_mask_set(True)
         gpu.matrix.load_matrix(Matrix.Identity(4))
         gpu.matrix.load_projection_matrix(Matrix(view.view_projection.tolist()))
         flat.bind()
         flat.uniform_float("color", (0.8, 0.8, 0.8, 1.0))
         batch.draw(flat)
         gpu.state.depth_test_set("NONE")
-    base = timed_draws(plain, offscreen)
-    offscreen.free()
-    return ours, base
+        gpu.state.depth_mask_set(False)
+    return plain
 
 
-def bench_scene(name: str, method: str) -> dict:
+def redraw_costs(drawing, positions, world, sizes) -> dict:
+    """(w, h) → (ours, flat, median of the rounds' differences) in seconds: Rendered shading's redraw and Blender's
+    flat builtin shader drawing the same triangles, from the scene camera."""
+    import bpy
+    import gpu
+
+    from bounce_gi.addon.extract.camera import read_camera
+    from bounce_gi.ui import draw
+
+    out = {}
+    for w, h in sizes:
+        target = gpu.types.GPUOffScreen(w, h, format="RGBA16F")  # the 3D view's colour buffer is RGBA16F too
+        view = draw.camera_view(read_camera(bpy.context.scene), w, h)
+        times = timed_rounds({"ours": lambda: draw.draw_view3d(drawing, view, world),
+                              "flat": flat_draw(positions, view)}, target)
+        target.free()
+        diff = [a - b for a, b in zip(times["ours"], times["flat"])]
+        out[(w, h)] = (statistics.median(times["ours"]), statistics.median(times["flat"]), statistics.median(diff))
+    return out
+
+
+def open_scene(name: str, method: str):
+    """Build example scene `name`, open it as a .blend (as a user would), set the method; bpy's gpu ready."""
     import bpy
 
     from bounce_gi.ui import draw
-    from bounce_gi.ui.viewport import ViewportFeed
     from examples import scenes
 
     path = os.path.join(tempfile.mkdtemp(), f"{name}.blend")
@@ -84,7 +107,13 @@ def bench_scene(name: str, method: str) -> dict:
     scene = bpy.context.scene
     scene.bounce_gi.method = method.upper()
     draw.ensure_gpu()
-    feed = ViewportFeed()
+    return scene
+
+
+def edit_latencies(feed, scene) -> dict:
+    """label → run_stages' row: the scene opened, then a light move, a material colour and an object move."""
+    import bpy
+
     handler_times = []
 
     def on_update(_scene, depsgraph):
@@ -113,20 +142,45 @@ def bench_scene(name: str, method: str) -> dict:
         bpy.context.view_layer.update()
         rows[label] = run_stages(feed, handler_times)
     bpy.app.handlers.depsgraph_update_post.remove(on_update)
-    ours, base = redraw_costs(feed.session.drawing, _positions(), feed.world_color)
-    scene.render.engine = "BOUNCE_GI"
-    scene.render.resolution_x, scene.render.resolution_y, scene.render.resolution_percentage = 160, 120, 100
+    return rows
+
+
+def f12_times(scene) -> dict:
+    """F12 at 160×120: "cold" with every pass run, "again" with the pass cache holding."""
+    import bpy
+
     from bounce_gi.gpu_kernels.engine import get_engine
 
+    scene.render.engine = "BOUNCE_GI"
+    scene.render.resolution_x, scene.render.resolution_y, scene.render.resolution_percentage = 160, 120, 100
     f12 = {}
-    for label, clear in (("cold", True), ("again", False)):  # cold: every pass runs; again: the cache holds
+    for label, clear in (("cold", True), ("again", False)):
         if clear:
             get_engine().clear_cache()
         start = time.perf_counter()
         bpy.ops.render.render(write_still=False)
         f12[label] = time.perf_counter() - start
+    return f12
+
+
+def bench_scene(name: str, method: str, sizes, redraw_only=False) -> dict:
+    import bpy
+
+    from bounce_gi.ui.viewport import ViewportFeed
+
+    scene = open_scene(name, method)
+    feed = ViewportFeed()
+    if redraw_only:
+        feed.update(bpy.context.evaluated_depsgraph_get(), first=True)
+        feed.session.wait()
+        rows = {}
+    else:
+        rows = edit_latencies(feed, scene)
+    redraw = redraw_costs(feed.session.drawing, _positions(), feed.world_color, sizes)
+    f12 = None if redraw_only else f12_times(scene)
+    stats = feed.session.stats
     feed.close()
-    return {"rows": rows, "redraw": (ours, base), "f12": f12, "texels": feed.session.stats.texels}
+    return {"rows": rows, "redraw": redraw, "f12": f12, "texels": stats.texels, "triangles": stats.triangles}
 
 
 def _positions():
@@ -153,27 +207,41 @@ def run_stages(feed, handler_times) -> dict:
             "upload": max(uploads) if uploads else 0.0, "changed": s.changed, "error": s.error}
 
 
+def print_scene(name: str, method: str, r: dict) -> None:
+    print(f"\n## {name} ({method}, {r['texels']} texels, {r['triangles']} triangles)")
+    if r["rows"]:
+        print(f"{'edit':<17}{'direct':>9}{'draft':>9}{'final':>9}{'handler':>10}{'upload':>9}   changed")
+    for label, row in r["rows"].items():
+        lat = row["latency"]
+        cells = "".join(f"{lat[k]:>8.2f}s" if k in lat else f"{'-':>9}" for k in ("direct", "draft", "final"))
+        print(f"{label:<17}{cells}{row['handler'] * 1000:>8.1f}ms{row['upload'] * 1000:>7.1f}ms   "
+              f"{row['changed']}{'  ERROR ' + row['error'] if row['error'] else ''}")
+    for (w, h), (ours, flat, diff) in r["redraw"].items():
+        print(f"redraw {w}x{h}: ours {ours * 1000:.2f} ms, builtin flat shader {flat * 1000:.2f} ms, "
+              f"difference {diff * 1000:.2f} ms")
+    if r["f12"]:
+        print(f"F12 160x120: {r['f12']['cold']:.2f} s with every pass run, {r['f12']['again']:.2f} s again")
+
+
 def main(argv=None) -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--method", default="lpv", choices=("none", "lpv", "vct"))
     p.add_argument("--scenes", nargs="+", default=["cornell", "spot_room", "courtyard"])
+    p.add_argument("--res", nargs="+", type=int, default=[960, 540], help="redraw sizes: W H [W H ...]")
+    p.add_argument("--redraw-only", action="store_true", help="time only the redraws of the final stage")
     args = p.parse_args(argv)
+    sizes = list(zip(args.res[0::2], args.res[1::2]))
     import bounce_gi
 
     bounce_gi.register()  # the scene settings, as the enabled extension has them
-    for name in args.scenes:
-        r = bench_scene(name, args.method)
-        ours, base = r["redraw"]
-        print(f"\n## {name} ({args.method}, {r['texels']} texels)")
-        print(f"{'edit':<17}{'direct':>9}{'draft':>9}{'final':>9}{'handler':>10}{'upload':>9}   changed")
-        for label, row in r["rows"].items():
-            lat = row["latency"]
-            cells = "".join(f"{lat[k]:>8.2f}s" if k in lat else f"{'-':>9}" for k in ("direct", "draft", "final"))
-            print(f"{label:<17}{cells}{row['handler'] * 1000:>8.1f}ms{row['upload'] * 1000:>7.1f}ms   "
-                  f"{row['changed']}{'  ERROR ' + row['error'] if row['error'] else ''}")
-        print(f"redraw 960x540: ours {ours * 1000:.2f} ms, builtin flat shader {base * 1000:.2f} ms, "
-              f"difference {(ours - base) * 1000:.2f} ms")
-        print(f"F12 160x120: {r['f12']['cold']:.2f} s with every pass run, {r['f12']['again']:.2f} s again")
+    try:
+        for name in args.scenes:
+            print_scene(name, args.method, bench_scene(name, args.method, sizes, args.redraw_only))
+    finally:
+        # Blender frees its GPU backend at exit before Python's last garbage collection: a shader or texture
+        # still alive then (the compiled viewport shader is a module global) crashed the exit with SIGSEGV.
+        # Disabling the extension releases them, and the engine's GL thread, first.
+        bounce_gi.unregister()
 
 
 if __name__ == "__main__":

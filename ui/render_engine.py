@@ -14,9 +14,9 @@ per view layer, mono only.
 
 Rendered shading: `view_update` hands the depsgraph's updates to a viewport.ViewportFeed (extract what the GI
 depends on, queue one job on the GPU thread, never wait); `view_draw` draws the newest finished result from the
-3D view's camera with draw.SurfaceDrawing into an offscreen buffer, then shows it through Blender's display-space
-shader (the view transform, as for any engine's image). Orbiting redraws; it re-runs no GI pass. Material Preview
-shading uses EEVEE (`bl_use_eevee_viewport`).
+3D view's camera with draw.SurfaceDrawing straight into the 3D view's scene-linear framebuffer (Blender applies
+the view transform, as for any engine's image: draw.draw_view3d). Orbiting redraws; it re-runs no GI pass.
+Material Preview shading uses EEVEE (`bl_use_eevee_viewport`).
 """
 import concurrent.futures
 import traceback
@@ -91,7 +91,6 @@ class BounceGIRenderEngine(bpy.types.RenderEngine):
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)  # Blender passes the engine's RNA pointer
         self.feed = None  # viewport.ViewportFeed, made by the first view_update
-        self.offscreen = None
 
     def __del__(self):
         try:
@@ -103,9 +102,6 @@ class BounceGIRenderEngine(bpy.types.RenderEngine):
         if getattr(self, "feed", None) is not None:
             self.feed.close()
             self.feed = None
-        if getattr(self, "offscreen", None) is not None:
-            self.offscreen.free()
-            self.offscreen = None
 
     def view_update(self, context, depsgraph):
         from .viewport import ViewportFeed
@@ -116,28 +112,14 @@ class BounceGIRenderEngine(bpy.types.RenderEngine):
         self.feed.update(depsgraph, first=first)
 
     def view_draw(self, context, depsgraph):
-        import gpu
-        from gpu_extras.presets import draw_texture_2d
-
         from . import draw
         from .viewport import region_view
 
-        region = context.region
-        width, height = region.width, region.height
-        if self.offscreen is None or (self.offscreen.width, self.offscreen.height) != (width, height):
-            if self.offscreen is not None:
-                self.offscreen.free()
-            self.offscreen = gpu.types.GPUOffScreen(width, height, format="RGBA16F")
         feed = self.feed
         drawing = feed.session.drawing if feed is not None else None
         background = feed.world_color if feed is not None else (0.0, 0.0, 0.0)
         mode = depsgraph.scene.bounce_gi.display_mode
-        draw.draw_offscreen(drawing, self.offscreen, region_view(context.region_data), background, mode)
-        gpu.state.blend_set("ALPHA_PREMULT")
-        self.bind_display_space_shader(depsgraph.scene)
-        draw_texture_2d(self.offscreen.texture_color, (0, 0), width, height)
-        self.unbind_display_space_shader()
-        gpu.state.blend_set("NONE")
+        draw.draw_view3d(drawing, region_view(context.region_data), background, mode)
         if feed is not None:
             self.update_stats("", feed.status())
 

@@ -3,36 +3,52 @@
 // gpu.types.GPUShaderCreateInfo, so this file holds only the stages' bodies): light looked up in the surface atlas
 // (gpu_kernels/surface/), where the render's own passes computed Diffuse Direct and Diffuse Indirect per texel —
 // uploaded already multiplied by the texel's base colour — times the view-dependent diffuse share of the
-// material as the G-buffer computes it (common/principled.glsl), plus emission: Cycles' Combined without the
-// glossy part, from any camera, with no GI pass per view.
+// material from the same table the G-buffer reads (common/principled.glsl: row 0 of each material, D(μ) at
+// texel centres μ = k/(n−1)), plus emission: Cycles' Combined without the glossy part, from any camera, with no
+// GI pass per view.
 //
 // The indirect light has an atlas of its own, coarser than the direct light's (it varies slowly): each vertex
-// carries its place in both (tile / box, tile_i / box_i).
+// carries its place in both (tile / box, tile_i / box_i). `material`: rgb the diffuse share where it does not
+// depend on the view (variant CONSTANT_SHARE), a the material's layer in u_material_lut (the other variant).
+//
+// On a software GL (llvmpipe) every fragment instruction is paid ~500 000 times a redraw, so whatever is the same
+// over a triangle is worked out per vertex and handed on flat: which page of the atlas the camera sees, the
+// tile's clamp bounds, the normal's sign. Variant CONSTANT_SHARE (ui/draw.py defines it) draws the triangles
+// whose material's diffuse share does not depend on the view (Diffuse BSDF, Principled with no specular layer):
+// the share comes as a vertex attribute, and the fragment skips the material table and the view vector.
 //
 // Push constants: u_view_projection; u_eye (xyz camera position, w 1 if orthographic); u_forward (xyz unit view
-// axis, w the direct atlas's page height in texels); u_params (x: 0 Combined, 1 indirect only, 2 direct only; y:
-// depth pulled toward the camera, in clip w — the overlay draws over Blender's own copy of the same surfaces;
-// z: the indirect atlas's page height).
+// axis, w depth pulled toward the camera, in clip w — the overlay draws over Blender's own copy of the same
+// surfaces); u_params (x, y: the direct and the indirect atlas's page heights in texels; z: weight of the direct
+// light and emission, w: weight of the indirect light — 1 or 0, the display mode).
 
 #if defined(VERTEX_SHADER)
 void main() {
-    v_position = pos;
-    v_normal = nrm;
-    v_geo_normal = geo;
+    vec3 to_eye = u_eye.w > 0.5 ? -u_forward.xyz : u_eye.xyz - pos;
+    // Two-sided as in Cycles: seen from behind, the surface is lit by the atlas's back page. dot(geo, eye - p)
+    // is the same at every point of the triangle's plane, so the provoking vertex decides for the triangle.
+    bool back = dot(geo, to_eye) < 0.0;
     v_tile = tile;
-    v_box = box;
     v_tile_i = tile_i;
-    v_box_i = box_i;
-    v_mat = mat;
+    // Stay on this triangle's texel centres: the 2×2 footprint never reaches a neighbouring tile.
+    v_clamp = vec4(box.xy + 0.5, box.xy + vec2(box.z) - 0.5);
+    v_clamp_i = vec4(box_i.xy + 0.5, box_i.xy + vec2(box_i.z) - 0.5);
     v_emission = emission;
+#if defined(CONSTANT_SHARE)
+    v_page = vec2(back ? u_params.x : 0.0, back ? u_params.y : 0.0);
+    v_share = material.rgb;
+#else
+    v_page = vec4(back ? u_params.x : 0.0, back ? u_params.y : 0.0, back ? -1.0 : 1.0, material.a);
+    // eye - p is affine in p, so interpolated it is the fragment's own view vector.
+    v_view = to_eye;
+    v_normal = nrm;
+#endif
     gl_Position = u_view_projection * vec4(pos, 1.0);
-    gl_Position.z -= u_params.y * gl_Position.w;
+    gl_Position.z -= u_forward.w * gl_Position.w;
 }
 #endif
 
 #if defined(FRAGMENT_SHADER)
-#include "common/principled.glsl"
-
 // Bilinear lookup at texel coordinate c (texel centres at +0.5): the textures are uploaded with linear filtering
 // (draw.rgba_texture), so one fetch.
 vec3 atlas_lookup(sampler2D atlas, vec2 c) {
@@ -40,19 +56,18 @@ vec3 atlas_lookup(sampler2D atlas, vec2 c) {
 }
 
 void main() {
-    vec3 to_eye = u_eye.w > 0.5 ? -u_forward.xyz : u_eye.xyz - v_position;
-    // Two-sided as in Cycles: seen from behind, the surface is lit by the atlas's back page.
-    bool back = dot(v_geo_normal, to_eye) < 0.0;
-    // Stay on this triangle's texel centres: the 2×2 footprint never reaches a neighbouring tile.
-    vec2 c = clamp(v_tile, v_box.xy + 0.5, v_box.xy + vec2(v_box.z) - 0.5);
-    vec2 c_i = clamp(v_tile_i, v_box_i.xy + 0.5, v_box_i.xy + vec2(v_box_i.z) - 0.5);
-    // The material's diffuse share at μ = n·v (its rows in u_material_lut, index v_mat.x).
-    vec3 n = normalize(v_normal) * (back ? -1.0 : 1.0);
-    vec3 share = principled_diffuse(u_material_lut, int(v_mat.x + 0.5), dot(n, normalize(to_eye)));
-    vec3 direct = share * atlas_lookup(u_direct, c + vec2(0.0, back ? u_forward.w : 0.0));
-    vec3 indirect = share * atlas_lookup(u_indirect, c_i + vec2(0.0, back ? u_params.z : 0.0));
-    int mode = int(u_params.x + 0.5);
-    vec3 color = mode == 1 ? indirect : mode == 2 ? direct + v_emission : direct + indirect + v_emission;
-    out_color = vec4(color, 1.0);
+    vec2 c = clamp(v_tile, v_clamp.xy, v_clamp.zw) + vec2(0.0, v_page.x);
+    vec2 c_i = clamp(v_tile_i, v_clamp_i.xy, v_clamp_i.zw) + vec2(0.0, v_page.y);
+#if defined(CONSTANT_SHARE)
+    vec3 share = v_share;
+#else
+    // The material's diffuse share at μ = n·v (one inverse square root for both lengths): its table row is layer
+    // v_page.w of u_material_lut, a 1D array texture, so linear filtering blends two texels, not four.
+    float mu = v_page.z * dot(v_normal, v_view) * inversesqrt(dot(v_normal, v_normal) * dot(v_view, v_view));
+    float size = float(textureSize(u_material_lut, 0).x);
+    vec3 share = texture(u_material_lut, vec2((clamp(mu, 0.0, 1.0) * (size - 1.0) + 0.5) / size, v_page.w)).rgb;
+#endif
+    vec3 light = u_params.z * atlas_lookup(u_direct, c) + u_params.w * atlas_lookup(u_indirect, c_i);
+    out_color = vec4(share * light + u_params.z * v_emission, 1.0);
 }
 #endif
