@@ -14,6 +14,14 @@ import numpy as np
 from ..common.grid import Grid
 from .gather import VPL_DTYPE
 
+# RSM records binned one per texel up to this many texels (bin_flux): merging texels first (lpv/inject.glsl's k×k
+# blocks) pools a block's surfaces — a sunlit wall's outside with the floor inside the window beside it — at a mean
+# position that can fall in another voxel, and which blocks pool depends on the atlas the lights make: the window
+# room's first bounce with its sun and sky together was 38 W, 1.6× the sum of either alone (9 + 15); per texel it
+# is 28.7 = 9.1 + 19.6, linear in the lights as the transfer assumes. 2^20 texels bin in well under a second.
+TEXEL_RECORDS = 1 << 20
+OWN_ALIGN = 0.5  # cos 60°: own_side
+
 
 @dataclass
 class Clusters:
@@ -171,12 +179,42 @@ def box_distance(points: np.ndarray, box: np.ndarray) -> np.ndarray:
     return np.linalg.norm(np.maximum(box[:, 0] - points, 0) + np.maximum(points - box[:, 1], 0), axis=1)
 
 
-def bin_flux(clusters: Clusters, records: np.ndarray) -> tuple[np.ndarray, float]:
-    """The VPL records' flux (RGB) per cluster. A record goes to a cluster of its block and side within a voxel
-    of it, the one whose plane lies nearest; else (a texel in a voxel that the geometry around it claims for
-    another side: a floor's edge at a wall) to the nearest cluster facing its way — unless it faces nothing (a
-    sunlit roof's top: that light leaves the scene). Never to a cluster farther than the voxels around it would
-    be: two rooms' floors share a block and a plane. Returns ((C, 3), the flux that leaves)."""
+def own_side(clusters: Clusters, cells: np.ndarray, normals: np.ndarray, pos: np.ndarray,
+             normal: np.ndarray) -> np.ndarray:
+    """Per record (positions `pos`, unit `normal`): the cluster of the side facing its way of the surface voxel it
+    lies in (`cells` (R, 3) and mean `normals` (R, 3): the voxels clusters.side_cluster numbers); −2 where that side
+    has none (it faces nothing: the record's light leaves the scene); −1 where the record's voxel holds no surface,
+    or where that side's mean normal lies more than 60° from the record's (OWN_ALIGN): the side is mostly other
+    surfaces — at a room's edge a voxel holds the ceiling's inside and the wall's outside on one side, and the
+    sunlit outside's light would light the room. (Two walls at a 90° junction lie 45° from their mean, three 55°.)"""
+    out = np.full(len(pos), -1, np.int64)
+    if len(cells) == 0:
+        return out
+    nx, ny, nz = (int(n) for n in clusters.fine.size)
+    lin = (cells[:, 2].astype(np.int64) * ny + cells[:, 1]) * nx + cells[:, 0]
+    order = np.argsort(lin)
+    f = np.floor((pos - np.asarray(clusters.fine.origin)) / clusters.fine.cell).astype(np.int64)
+    want = (f[:, 2] * ny + f[:, 1]) * nx + f[:, 0]
+    r = order[np.minimum(np.searchsorted(lin[order], want), len(lin) - 1)]
+    hit = np.all((f >= 0) & (f < (nx, ny, nz)), axis=1) & (lin[r] == want) & (np.linalg.norm(normals[r], axis=1) > 0)
+    facing = np.einsum("ij,ij->i", normals[r], normal) / np.maximum(np.linalg.norm(normals[r], axis=1), 1e-30)
+    hit &= np.abs(facing) >= OWN_ALIGN
+    c = clusters.side_cluster[r, (facing < 0).astype(np.int64)]
+    out[hit] = np.where(c[hit] >= 0, c[hit], -2)
+    return out
+
+
+def bin_flux(clusters: Clusters, records: np.ndarray, cells: np.ndarray | None = None,
+             normals: np.ndarray | None = None) -> tuple[np.ndarray, float]:
+    """The VPL records' flux (RGB) per cluster. With the clusters' voxels (`cells`, `normals`), a record goes to
+    the cluster of its own voxel's side that faces its way (own_side), or leaves the scene where that side faces
+    nothing: a record on the outside of a room's wall is not the inside's, however near a cluster of the room that
+    faces its way lies (the back of a sofa 15 cm inside the wall took a sunlit wall's outside light: a window room's
+    first bounce was 2.7× what its window lets in). A record whose voxel holds no surface (or any record, without
+    `cells`) goes to a cluster of its block and side within a voxel of it, the one whose plane lies nearest; else
+    (a texel in a voxel that the geometry around it claims for another side: a floor's edge at a wall) to the
+    nearest cluster facing its way. A record that faces nothing (a sunlit roof's top) leaves the scene, whatever
+    voxel side it shares with other surfaces. Returns ((C, 3), the flux that leaves)."""
     out = np.zeros((clusters.count, 3))
     if len(records) == 0:
         return out, 0.0
@@ -186,9 +224,12 @@ def bin_flux(clusters: Clusters, records: np.ndarray) -> tuple[np.ndarray, float
     key = block_keys(pos, normal, clusters.fine, clusters.block)
     first = np.searchsorted(clusters.key, key, "left")
     last = np.searchsorted(clusters.key, key, "right")
+    faces = faces_something(pos, normal, clusters.lo, clusters.hi, near)
+    own = np.full(len(records), -1) if cells is None else own_side(clusters, cells, normals, pos, normal)
+    own[~faces] = -2  # nothing lies before it (a roof's top): its light leaves, whichever voxel side it shares
     target = np.full(len(records), -1)
     offset = np.einsum("ij,ij->i", normal, pos)
-    best = np.full(len(records), np.inf)
+    best = np.where(own == -1, np.inf, -np.inf)  # records with a voxel of their own take no other
     for j in range(int((last - first).max(initial=0))):  # candidates of one key: usually one, a few planes at most
         c = np.minimum(first + j, clusters.count - 1)
         lo, hi = clusters.offsets[c, 0], clusters.offsets[c, 1]
@@ -196,7 +237,8 @@ def bin_flux(clusters: Clusters, records: np.ndarray) -> tuple[np.ndarray, float
         d = np.where((first + j < last) & (box_distance(pos, clusters.box[c]) <= near), plane, np.inf)
         better = d < best
         target[better], best[better] = c[better], d[better]
-    lost = np.nonzero((target < 0) & faces_something(pos, normal, clusters.lo, clusters.hi, near))[0]
+    target = np.where(own >= 0, own, target)
+    lost = np.nonzero((target < 0) & (own == -1))[0]
     for chunk in np.array_split(lost, max(1, len(lost) // 256)) if len(lost) and clusters.count else ():
         facing = normal[chunk] @ clusters.records["normal"][:, :3].T > 0.5  # (n, C)
         gap = np.maximum(clusters.box[None, :, 0] - pos[chunk, None], 0) + \

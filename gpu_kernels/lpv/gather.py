@@ -111,11 +111,12 @@ def _fitted(ctx, records: np.ndarray, size: float, block: int, budget: int) -> V
     return VplList(ctx.buffer(payload), len(records), flux, block)
 
 
-def rsm_records(ctx, programs, rsm, shadows, grid: Grid, budget: int) -> tuple[np.ndarray, int]:
+def rsm_records(ctx, programs, rsm, shadows, grid: Grid, budget: int, limit: int | None = None
+                ) -> tuple[np.ndarray, int]:
     """The RSM as VPL records (VPL_DTYPE) and k: k×k texel blocks (intensity-aware, lpv/inject.glsl MODE_LIST), k the
-    smallest power of two whose lit blocks number at most a few times `budget` (much of an atlas is empty: a
-    sun's map covers the whole grid, a spot's cone a disc). A block spanning two surfaces gives two VPLs; the
-    grid's cell sets the plane tolerance."""
+    smallest power of two whose blocks number at most `limit` (default a few times `budget`: much of an atlas is
+    empty, a sun's map covers the whole grid, a spot's cone a disc). A block spanning two surfaces gives two VPLs;
+    the grid's cell sets the plane tolerance."""
     prog = programs.compute("lpv/inject.glsl", {"MODE_LIST": 1})
     bind_grid(prog, grid)
 
@@ -126,7 +127,8 @@ def rsm_records(ctx, programs, rsm, shadows, grid: Grid, budget: int) -> tuple[n
                         lambda: dispatch(prog, (blocks[0], blocks[1]), local=8))
 
     k = 1
-    while k < MAX_BLOCK and -(-rsm.size[0] // k) * -(-rsm.size[1] // k) > PRECLUSTER * budget:
+    limit = PRECLUSTER * budget if limit is None else limit
+    while k < MAX_BLOCK and -(-rsm.size[0] // k) * -(-rsm.size[1] // k) > limit:
         k *= 2  # cluster on the GPU first, so that the read-back stays a few times the budget
     return cluster(k), k
 

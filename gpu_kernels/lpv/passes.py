@@ -122,7 +122,8 @@ def _transfer(frame, grids, k_grids, maps, k_rsm, budget) -> MethodOutput:
     gvs, transfers, _, reflection, keys = _transfer_geometry(frame, grids, k_grids, budget)
     k_src = (k_rsm, keys["transfer"])
     sources = cache.run("lpv_inject", k_src, lambda: [clusters.bin_flux(t.clusters, gather.rsm_records(
-        ctx, programs, maps, frame.shadows, grid, budget)[0]) for t, grid in zip(transfers, grids)])
+        ctx, programs, maps, frame.shadows, grid, budget, clusters.TEXEL_RECORDS)[0], t.cells, t.normals)
+        for t, grid in zip(transfers, grids)])
     k_prop = (k_src, keys["albedo_transfer"], keys["gv"], s.max_iterations, s.clamp_negative, s.bounces, s.epsilon)
     solved = cache.run("lpv_propagate", k_prop, lambda: _solve(ctx, gvs, grids, transfers, reflection, sources, s))
     k_light = (frame.keys["gbuffer"], k_prop)

@@ -83,6 +83,29 @@ def test_flux_on_a_side_facing_nothing_leaves_the_scene():
     assert flux.sum() == 0 and escaped == pytest.approx(30.0)
 
 
+def test_flux_on_a_walls_outside_stays_out_however_near_an_inside_surface_faces_its_way():
+    """A room's back wall (y index 30, one-sided, its inside facing −y) with a sofa's back in the voxel row inside
+    it (y index 29, its voxels' mean normal mostly +y, toward the wall, and a little up: the sofa's top shares
+    them): both in one block, on the same side key (+y). A sunlit record on the
+    wall's outside (facing +y, in the wall's voxel) is outside the room: nothing lies before it, so it leaves the
+    scene — it must not go to the sofa's back, the nearest +y cluster within a voxel (which it did:
+    a window room's first bounce was 2.7× what its window lets in). A record on the sofa's back goes there."""
+    wall = _plane(1, 30, (0, 0), (40, 27), sign=-1.0)
+    sofa = _plane(1, 29, (10, 0), (30, 8), sign=1.0)
+    sofa[1][:] = (0.0, 0.94, 0.34)
+    floor = _plane(2, 0, (0, 0), (40, 30))
+    cells, normals, areas = _scene(wall, sofa, floor)
+    c = cl.make_clusters(cells, normals, areas, FINE, budget=64)
+    outside = np.c_[np.full(4, 0.35), np.full(4, 3.03), np.full(4, 2.0)]  # in the wall's voxels, facing +y
+    on_sofa = np.c_[np.full(4, 0.35), np.full(4, 2.95), np.full(4, 2.0)]
+    up = np.tile((0, 1.0, 0), (4, 1))
+    flux, escaped = cl.bin_flux(c, _records(outside, up, np.ones((4, 3))), cells, normals)
+    assert flux.sum() == 0 and escaped == pytest.approx(12.0)
+    flux, escaped = cl.bin_flux(c, _records(on_sofa, sofa[1][:4], np.ones((4, 3))), cells, normals)
+    assert escaped == 0 and flux.sum() == pytest.approx(12.0)
+    assert (c.records["normal"][flux[:, 0] > 0, 1] > 0.9).all()  # the sofa's back
+
+
 def _reflect(clusters, weight, irradiance):
     """The flux the voxel sides reflect, per cluster (C, 3): Σ albedo × area × E over each cluster's sides.
     `weight` (R, 3) = albedo × area; `irradiance` (2, R, 3) per side."""

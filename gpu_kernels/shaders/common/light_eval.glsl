@@ -2,6 +2,7 @@
 // Unshadowed light evaluation shared by direct lighting and RSM flux (one implementation of Cycles' light units).
 #pragma once
 #include "common/lights.glsl"
+#include "common/polygon.glsl"
 
 const float PI = 3.14159265358979;
 
@@ -18,16 +19,6 @@ int cube_face(vec3 d) {
     if (a.x >= a.y && a.x >= a.z) return d.x > 0.0 ? 0 : 1;
     if (a.y >= a.z) return d.y > 0.0 ? 2 : 3;
     return d.z > 0.0 ? 4 : 5;
-}
-
-// One edge's term of Lambert's formula, angle(a, b) · n·normalize(a × b), for a, b relative to the receiver; atan2
-// for the angle so short edges stay accurate.
-float lambert_edge(vec3 a, vec3 b, vec3 n) {
-    a = normalize(a);
-    b = normalize(b);
-    vec3 c = cross(a, b);
-    float s = length(c);
-    return s < 1e-12 ? 0.0 : atan(s, dot(a, b)) * dot(n, c) / s;
 }
 
 // ∫ over the polygon of cosθ dω (projected solid angle), polygon clipped to the upper hemisphere of n.
@@ -54,28 +45,6 @@ float polygon_projected_solid_angle(int first, int count, vec3 p, vec3 n) {
     if (m < 3) return 0.0;
     float sum = 0.0;
     for (int i = 0; i < m; ++i) sum += lambert_edge(clipped[i], clipped[(i + 1) % m], n);
-    return abs(sum) * 0.5;
-}
-
-// The part of edge a→b above the plane (heights ha, hb), appended to q (one Sutherland–Hodgman step).
-void clip_edge(vec3 a, vec3 b, float ha, float hb, inout vec3 q[4], inout int m) {
-    if (ha >= 0.0 && m < 4) q[m++] = a;
-    if ((ha >= 0.0) != (hb >= 0.0) && m < 4) q[m++] = a + (b - a) * (ha / (ha - hb));
-}
-
-// polygon_projected_solid_angle of one triangle (vertices relative to the receiver), without loops: an emitter
-// cluster holds many, and llvmpipe caps a shader invocation's loop iterations (docs/conventions.md).
-float triangle_projected_solid_angle(vec3 a, vec3 b, vec3 c, vec3 n) {
-    float ha = dot(a, n), hb = dot(b, n), hc = dot(c, n);
-    if (max(ha, max(hb, hc)) <= 1e-5 * max(length(a), max(length(b), length(c)))) return 0.0;
-    vec3 q[4];
-    int m = 0;
-    clip_edge(a, b, ha, hb, q, m);
-    clip_edge(b, c, hb, hc, q, m);
-    clip_edge(c, a, hc, ha, q, m);
-    if (m < 3) return 0.0;
-    float sum = lambert_edge(q[0], q[1], n) + lambert_edge(q[1], q[2], n);
-    sum += m == 4 ? lambert_edge(q[2], q[3], n) + lambert_edge(q[3], q[0], n) : lambert_edge(q[2], q[0], n);
     return abs(sum) * 0.5;
 }
 

@@ -23,6 +23,7 @@
 // The result is added, per side, to what lpv/absorb.glsl found (zeros: world light is the sky light's VPLs), so the flux
 // lookup (lpv/lighting.glsl, MODE_FLUX) reads it unchanged; the next bounce's VPLs come from it (lpv/cluster.glsl).
 #include "lpv/common.glsl"
+#include "common/polygon.glsl"
 
 layout(local_size_x = 64) in;
 #include "common/structs.glsl"
@@ -47,6 +48,8 @@ layout(std430, binding = 8) writeonly buffer Transfer { vec2 transfer[]; };  // 
 uniform bool u_update;
 uniform vec3 u_box_lo;
 uniform vec3 u_box_hi;
+// Per source: the min / max corner of its voxels' centres (lpv/clusters.Clusters.box), w unused.
+layout(std430, binding = 9) readonly buffer SourceBoxes { vec4 source_boxes[]; };
 
 bool crosses_box(vec3 a, vec3 b) {  // the segment a → b meets the box (slab test)
     vec3 d = b - a;
@@ -70,6 +73,7 @@ vec3 step01(vec3 d) {
     return vec3(greaterThan(d, vec3(0.0)));
 }
 const float NEAR_FIELD = 9.0;  // (distance / disc radius)² below which a VPL is split in four
+const float AXIS_PLANE = 0.985;  // a source whose normal is within 10° of an axis lies in that axis' plane
 
 // Visibility between a VPL at `from` and a receiver `dist` away along unit `dir`: the ray walks the LPV cells it passes
 // (the traversal of Amanatides and Woo 1987) and, in each, meets the cell's surfaces only if it crosses the plane where
@@ -117,9 +121,36 @@ float transmittance(vec3 from, vec3 dir, float dist) {
     return 1.0 - crossings;
 }
 
-// What a VPL of unit flux gives a receiver voxel at p (normal nv) per side: (front, back) irradiance per watt, so
-// that E = Φ · kernel. Linear in Φ: the transfer (MODE_TRANSFER) stores it per receiver and source.
-vec2 vpl_kernel(Vpl v, vec3 p, vec3 nv, float h) {
+#if defined(MODE_TRANSFER)
+// Near a cluster that lies in an axis plane (a wall's, a floor's): the exact irradiance per watt of a Lambertian
+// rectangle of uniform radiance Φ/(π·A) spanning its voxels in that plane — Lambert's formula on its two triangles
+// (common/polygon.glsl), per side of the receiver. A receiver beside a wall's edge gets half its irradiance from the
+// floor right next to it; the quarter discs below, 1–2 cells out, gave edges 0.7–0.9 of it in a closed box.
+bool rectangle_kernel(int j, Vpl v, vec3 p, vec3 nv, float h, out vec2 k) {
+    vec3 a = abs(v.normal.xyz);
+    int axis = a.x >= a.y ? (a.x >= a.z ? 0 : 2) : (a.y >= a.z ? 1 : 2);
+    if (a[axis] < AXIS_PLANE * length(v.normal.xyz)) return false;
+    int b = (axis + 1) % 3, c = (axis + 2) % 3;
+    vec3 lo = source_boxes[2 * j].xyz - 0.5 * h, hi = source_boxes[2 * j + 1].xyz + 0.5 * h;  // voxels' extent
+    vec3 q[4];
+    for (int i = 0; i < 4; ++i) {
+        q[i][axis] = v.position[axis] - p[axis];
+        q[i][b] = ((i == 1 || i == 2) ? hi[b] : lo[b]) - p[b];
+        q[i][c] = (i >= 2 ? hi[c] : lo[c]) - p[c];
+    }
+    float area = (hi[b] - lo[b]) * (hi[c] - lo[c]);
+    float front = triangle_projected_solid_angle(q[0], q[1], q[2], nv) + triangle_projected_solid_angle(q[0], q[2],
+                                                                                                  q[3], nv);
+    float back = triangle_projected_solid_angle(q[0], q[1], q[2], -nv) + triangle_projected_solid_angle(q[0], q[2],
+                                                                                                  q[3], -nv);
+    k = vec2(front, back) / (PI * area);
+    return true;
+}
+#endif
+
+// What VPL j (v) of unit flux gives a receiver voxel at p (normal nv) per side: (front, back) irradiance per watt,
+// so that E = Φ · kernel. Linear in Φ: the transfer (MODE_TRANSFER) stores it per receiver and source.
+vec2 vpl_kernel(int j, Vpl v, vec3 p, vec3 nv, float h) {
     vec3 nl = v.normal.xyz;
     vec3 d = p - v.position.xyz;
     // Height above the VPL's plane: ≤ 0 behind it (no light); under half a voxel (its box's extent along the
@@ -139,6 +170,10 @@ vec2 vpl_kernel(Vpl v, vec3 p, vec3 nv, float h) {
         float e = height / dist * abs(receive) * t / (PI * d2 + source_area);
         return receive > 0.0 ? vec2(e, 0.0) : vec2(0.0, e);
     }
+#if defined(MODE_TRANSFER)
+    vec2 exact;
+    if (rectangle_kernel(j, v, p, nv, h, exact)) return exact * t;
+#endif
     // Near a cluster (within 3 of its disc radii) its centroid is a poor stand-in — at a corner the
     // centroid sits level with a receiver its nearer part faces: four quarter discs, at their centroids
     // (0.6 radii out along the diagonals), each with a quarter of the flux and area. Visibility: the centroid's.
@@ -172,13 +207,13 @@ void main() {
     for (int j = u_vpl_first; j < u_vpl_first + u_vpl_count; ++j) {
         bool fresh = fresh_receiver || vpls[j].flux.w != 0.0 || crosses_box(vpls[j].position.xyz, p);
         transfer[(j - u_vpl_first) * u_surface_count + int(gl_GlobalInvocationID.x)] =
-            !fresh ? vec2(uintBitsToFloat(0x7fc00000u)) : receives ? vpl_kernel(vpls[j], p, nv, h) : vec2(0.0);
+            !fresh ? vec2(uintBitsToFloat(0x7fc00000u)) : receives ? vpl_kernel(j, vpls[j], p, nv, h) : vec2(0.0);
     }
 #else
     if (!receives) return;
     vec3 front = vec3(0.0), back = vec3(0.0);
     for (int j = u_vpl_first; j < u_vpl_first + u_vpl_count; ++j) {
-        vec2 k = vpl_kernel(vpls[j], p, nv, h);
+        vec2 k = vpl_kernel(j, vpls[j], p, nv, h);
         front += vpls[j].flux.rgb * k.x;
         back += vpls[j].flux.rgb * k.y;
     }
