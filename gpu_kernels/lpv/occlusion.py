@@ -109,6 +109,15 @@ def crossing_layers(area: np.ndarray, normal: np.ndarray, grid: Grid) -> tuple[n
     return coverage, layers
 
 
+def layer_area(area: np.ndarray, normals: np.ndarray, cell: float) -> np.ndarray:
+    """The surface area (R,) a voxel of side `cell` presents to light, at most one layer's: the largest section of
+    the voxel across its mean normal n, cell² / max|n_i|. Two surfaces stacked within a voxel — a rug 1 mm over a
+    floor, a duplicated face — receive and reflect as one (the covered one is in its shadow); their summed area
+    made the LPV reflect them twice (a coplanar duplicate face 10% brighter)."""
+    unit = normals / np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-30)
+    return np.minimum(area, cell * cell / np.maximum(np.abs(unit).max(axis=1), 1e-30))
+
+
 def geometry_volumes(ctx, programs, scene: Scene, geometry, textures, grids: list) -> list:
     """Fuzzy-occlusion volumes, one per cascade, from a voxelisation of the whole scene (view-independent).
 
@@ -141,8 +150,9 @@ def geometry_volumes(ctx, programs, scene: Scene, geometry, textures, grids: lis
         z, y, x = np.nonzero(area[..., 3] > 0)
         cells = np.stack([x, y, z, np.zeros_like(x)], axis=1).astype(np.int32)
         surfaces = ctx.buffer(cells.tobytes() if len(cells) else np.zeros(4, np.int32).tobytes())
+        normals = arrays["normal"][z, y, x, :3]
         out.append(GeometryVolume(tex, fine, vox.area, vox.normal, vox.albedo, *crossings, surfaces, len(cells),
-                                  cells[:, :3], arrays["normal"][z, y, x, :3], area[z, y, x, 3],
+                                  cells[:, :3], normals, layer_area(area[z, y, x, 3], normals, fine.cell),
                                   arrays["albedo"][z, y, x, :3]))
     return out
 
