@@ -3,9 +3,11 @@
 error against Cycles' vertex bake on two example scenes, the mesh data left exactly as it was apart from the one
 attribute, the options, bad input, and Esc in the modal path writing nothing.
 
-Undo itself cannot run here (`ed.undo` needs a window, which background mode lacks); what Undo relies on is tested
-instead: the bake changes nothing but the "BounceGI" attributes, in one operator call, and a failed or cancelled one
-changes nothing at all.
+Undo: background Blender runs `ed.undo` / `ed.redo` over steps pushed with `ed.undo_push`, but pushes no step
+after an operator by itself (the window manager does that interactively, for operators with the UNDO option, which
+the bake has). So the undo test pushes the step the window manager would, and checks that undoing it restores every
+mesh exactly and redoing it brings the bake back; the other tests check that the bake changes nothing but the
+"BounceGI" attributes, in one operator call, and that a failed or cancelled one changes nothing at all.
 """
 import os
 import subprocess
@@ -173,4 +175,29 @@ def test_bad_input_and_esc_write_nothing(tmp_path):
         print(ret, [e for e in log if e[0] != "status"])
         assert ret == {"FINISHED"} and any(e[0] == "INFO" and "baked" in e[1] for e in log if isinstance(e, tuple))
         assert all(bake.ATTRIBUTE in o.data.color_attributes for o in meshes)
+    """)
+
+
+def test_one_undo_step_takes_the_bake_back(tmp_path):
+    run_case(tmp_path, """
+        scenes.build("cornell")
+        scene = bpy.context.scene
+        scene.bounce_gi.method, scene.bounce_gi.quality = "LPV", "DRAFT"
+        names = [o.name for o in scene.objects if o.type == "MESH"]
+        meshes = lambda: [bpy.data.objects[n] for n in names]  # undo reloads the data: fetch it anew
+        bpy.ops.ed.undo_push(message="scene built")
+        scene.frame_current = 7  # a mark of the step before the bake
+        bpy.ops.ed.undo_push(message="before the bake")
+        before = mesh_state(meshes())
+        assert bpy.ops.bounce_gi.bake_color_attribute() == {"FINISHED"}
+        bpy.ops.ed.undo_push(message="Bake GI to Color Attribute")  # what the window manager pushes (UNDO option)
+        ours = baked(meshes())
+        assert bpy.ops.ed.undo() == {"FINISHED"}
+        assert not any(bake.ATTRIBUTE in o.data.attributes for o in meshes()), "the bake survived one undo"
+        same_state(before, mesh_state(meshes()))
+        assert bpy.context.scene.frame_current == 7  # the step just before the bake, not an older one
+        assert bpy.ops.ed.redo() == {"FINISHED"}
+        again = baked(meshes())
+        assert all(np.array_equal(again[k], ours[k]) for k in ours)
+        print("undo: the bake taken back in one step and redone,", sum(len(v) for v in ours.values()), "vertices")
     """)
