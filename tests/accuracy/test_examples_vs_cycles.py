@@ -47,27 +47,27 @@ from examples import references  # noqa: E402
 # TEXEL_RECORDS); a voxel's surfaces presenting at most one layer's area (lpv/occlusion.layer_area).
 BOUNDS = {
     'default_principled': {
-        'lpv': {'Combined': 0.041, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.107, 'Diffuse Color': 0.003, 'Glossy Direct': 0.010, 'Glossy Indirect': 0.550, 'Glossy Color': 0.020, 'Diffuse Light': 0.034, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.042, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.107, 'Diffuse Color': 0.003, 'Glossy Direct': 0.010, 'Glossy Indirect': 0.555, 'Glossy Color': 0.020, 'Diffuse Light': 0.034, 'Diffuse Color match': 0.998},
         'vct': {'Combined': 0.042, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.124, 'Diffuse Color': 0.003, 'Glossy Direct': 0.010, 'Glossy Indirect': 0.394, 'Glossy Color': 0.020, 'Diffuse Light': 0.038, 'Diffuse Color match': 0.998},
     },
     'metals': {
-        'lpv': {'Combined': 0.053, 'Diffuse Direct': 0.014, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.034, 'Glossy Indirect': 0.592, 'Glossy Color': 0.013, 'Diffuse Light': 0.028, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.054, 'Diffuse Direct': 0.014, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.034, 'Glossy Indirect': 0.597, 'Glossy Color': 0.013, 'Diffuse Light': 0.028, 'Diffuse Color match': 0.998},
         'vct': {'Combined': 0.046, 'Diffuse Direct': 0.014, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.034, 'Glossy Indirect': 0.542, 'Glossy Color': 0.013, 'Diffuse Light': 0.029, 'Diffuse Color match': 0.998},
     },
     'textured': {
-        'lpv': {'Combined': 0.016, 'Diffuse Direct': 0.002, 'Diffuse Indirect': 0.115, 'Diffuse Color': 0.002, 'Diffuse Light': 0.016, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.017, 'Diffuse Direct': 0.002, 'Diffuse Indirect': 0.120, 'Diffuse Color': 0.002, 'Diffuse Light': 0.017, 'Diffuse Color match': 0.998},
         'vct': {'Combined': 0.022, 'Diffuse Direct': 0.002, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.002, 'Diffuse Light': 0.021, 'Diffuse Color match': 0.998},
     },
     'window_room': {
-        'lpv': {'Combined': 0.177, 'Diffuse Direct': 0.138, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.574, 'Glossy Indirect': 0.390, 'Glossy Color': 0.018, 'Diffuse Light': 0.154, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.177, 'Diffuse Direct': 0.138, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.574, 'Glossy Indirect': 0.390, 'Glossy Color': 0.018, 'Diffuse Light': 0.155, 'Diffuse Color match': 0.998},
         'vct': {'Combined': 0.164, 'Diffuse Direct': 0.138, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.574, 'Glossy Indirect': 0.351, 'Glossy Color': 0.018, 'Diffuse Light': 0.145, 'Diffuse Color match': 0.998},
     },
     'rug_room': {
-        'lpv': {'Combined': 0.151, 'Diffuse Direct': 0.003, 'Diffuse Indirect': 0.308, 'Diffuse Color': 0.002, 'Glossy Direct': 0.016, 'Glossy Indirect': 0.416, 'Glossy Color': 0.020, 'Diffuse Light': 0.133, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.151, 'Diffuse Direct': 0.003, 'Diffuse Indirect': 0.307, 'Diffuse Color': 0.002, 'Glossy Direct': 0.016, 'Glossy Indirect': 0.415, 'Glossy Color': 0.020, 'Diffuse Light': 0.133, 'Diffuse Color match': 0.998},
         'vct': {'Combined': 0.080, 'Diffuse Direct': 0.003, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.002, 'Glossy Direct': 0.016, 'Glossy Indirect': 0.294, 'Glossy Color': 0.020, 'Diffuse Light': 0.075, 'Diffuse Color match': 0.998},
     },
     'thin_walls': {
-        'lpv': {'Combined': 0.186, 'Diffuse Direct': 0.255, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.002, 'Glossy Direct': 0.992, 'Glossy Indirect': 0.555, 'Glossy Color': 0.025, 'Diffuse Light': 0.185, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.186, 'Diffuse Direct': 0.255, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.002, 'Glossy Direct': 0.992, 'Glossy Indirect': 0.551, 'Glossy Color': 0.025, 'Diffuse Light': 0.185, 'Diffuse Color match': 0.998},
         'vct': {'Combined': 0.205, 'Diffuse Direct': 0.255, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.002, 'Glossy Direct': 0.992, 'Glossy Indirect': 0.504, 'Glossy Color': 0.025, 'Diffuse Light': 0.206, 'Diffuse Color match': 0.998},
     },
     'lamp_room': {
@@ -75,23 +75,23 @@ BOUNDS = {
         'vct': {'Combined': 0.080, 'Diffuse Direct': 0.043, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.002, 'Glossy Direct': 0.036, 'Glossy Indirect': 0.387, 'Glossy Color': 0.017, 'Emission': 0.002, 'Diffuse Light': 0.138, 'Diffuse Color match': 0.998},
     },
     'many_lights': {
-        'lpv': {'Combined': 0.069, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.103, 'Diffuse Color': 0.004, 'Glossy Direct': 0.057, 'Glossy Indirect': 0.214, 'Glossy Color': 0.032, 'Diffuse Light': 0.070, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.069, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.104, 'Diffuse Color': 0.004, 'Glossy Direct': 0.057, 'Glossy Indirect': 0.214, 'Glossy Color': 0.032, 'Diffuse Light': 0.071, 'Diffuse Color match': 0.998},
         'vct': {'Combined': 0.137, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.210, 'Diffuse Color': 0.004, 'Glossy Direct': 0.057, 'Glossy Indirect': 0.256, 'Glossy Color': 0.032, 'Diffuse Light': 0.143, 'Diffuse Color match': 0.998},
     },
     'outdoor': {
-        'lpv': {'Combined': 0.047, 'Diffuse Direct': 0.018, 'Diffuse Indirect': 0.250, 'Diffuse Color': 0.003, 'Glossy Direct': 0.100, 'Glossy Indirect': 0.661, 'Glossy Color': 0.033, 'Diffuse Light': 0.028, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.047, 'Diffuse Direct': 0.018, 'Diffuse Indirect': 0.251, 'Diffuse Color': 0.003, 'Glossy Direct': 0.100, 'Glossy Indirect': 0.661, 'Glossy Color': 0.033, 'Diffuse Light': 0.028, 'Diffuse Color match': 0.998},
         'vct': {'Combined': 0.049, 'Diffuse Direct': 0.018, 'Diffuse Indirect': 0.310, 'Diffuse Color': 0.003, 'Glossy Direct': 0.100, 'Glossy Indirect': 0.684, 'Glossy Color': 0.033, 'Diffuse Light': 0.031, 'Diffuse Color match': 0.998},
     },
     'product_shot': {
-        'lpv': {'Combined': 0.059, 'Diffuse Direct': 0.041, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.043, 'Glossy Indirect': 0.616, 'Glossy Color': 0.016, 'Diffuse Light': 0.051, 'Diffuse Color match': 0.996},
+        'lpv': {'Combined': 0.060, 'Diffuse Direct': 0.041, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.043, 'Glossy Indirect': 0.621, 'Glossy Color': 0.016, 'Diffuse Light': 0.052, 'Diffuse Color match': 0.996},
         'vct': {'Combined': 0.060, 'Diffuse Direct': 0.041, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.043, 'Glossy Indirect': 0.496, 'Glossy Color': 0.016, 'Diffuse Light': 0.054, 'Diffuse Color match': 0.996},
     },
     'furnished': {
-        'lpv': {'Combined': 0.080, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.063, 'Glossy Indirect': 0.268, 'Glossy Color': 0.025, 'Emission': 0.009, 'Diffuse Light': 0.101, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.080, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.063, 'Glossy Indirect': 0.269, 'Glossy Color': 0.025, 'Emission': 0.009, 'Diffuse Light': 0.102, 'Diffuse Color match': 0.998},
         'vct': {'Combined': 0.080, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.063, 'Glossy Indirect': 0.237, 'Glossy Color': 0.025, 'Emission': 0.009, 'Diffuse Light': 0.088, 'Diffuse Color match': 0.998},
     },
     'cornell_animated': {
-        'lpv': {'Combined': 0.064, 'Diffuse Direct': 0.014, 'Diffuse Indirect': 0.131, 'Diffuse Color': 0.002, 'Diffuse Light': 0.063, 'Diffuse Color match': 0.999},
+        'lpv': {'Combined': 0.064, 'Diffuse Direct': 0.014, 'Diffuse Indirect': 0.132, 'Diffuse Color': 0.002, 'Diffuse Light': 0.063, 'Diffuse Color match': 0.999},
         'vct': {'Combined': 0.069, 'Diffuse Direct': 0.014, 'Diffuse Indirect': 0.144, 'Diffuse Color': 0.002, 'Diffuse Light': 0.069, 'Diffuse Color match': 0.999},
     },
 }
