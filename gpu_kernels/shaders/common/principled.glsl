@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Principled BSDF's layering, read from the material table (common/principled.py: material_lut) with no other
-// uniforms, so the camera's G-buffer (common/materials.glsl) and the viewport's fragment shader
-// (viewport/surface.glsl) colour surfaces alike. Each material has five rows of texels over μ = n·v ∈ [0, 1]:
+// uniforms, so every pass that shades a surface (the camera's G-buffer, common/materials.glsl) colours it alike; the
+// viewport's fragment shader (viewport/surface.glsl) reads row 0 of the same table through a 1D array texture of
+// its own. Each material has five rows of texels over μ = n·v ∈ [0, 1]:
 //   row 0: rgb D(μ), the share of the base colour in Cycles' Diffuse Color;  a: E(μ), the GGX lobe's albedo
 //   row 1: rgb the coat's and the dielectric layer's Glossy Color;           a: s5(μ), the lobe-averaged Schlick weight
 //   row 2: rgb the metallic closure's weight;                               a: E_avg
