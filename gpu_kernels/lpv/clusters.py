@@ -209,8 +209,8 @@ def bin_flux(clusters: Clusters, records: np.ndarray, cells: np.ndarray | None =
     """The VPL records' flux (RGB) per cluster. With the clusters' voxels (`cells`, `normals`), a record goes to
     the cluster of its own voxel's side that faces its way (own_side), or leaves the scene where that side faces
     nothing: a record on the outside of a room's wall is not the inside's, however near a cluster of the room that
-    faces its way lies (the back of a sofa 15 cm inside the wall took a sunlit wall's outside light: a window room's
-    first bounce was 2.7× what its window lets in). A record whose voxel holds no surface (or any record, without
+    faces its way lies (a sofa's back inside the wall, a corner voxel that also holds the ceiling's inside: in the
+    window room, lit by its sun alone, 5 W of the 9 W binned came from the sunlit outside). A record whose voxel holds no surface (or any record, without
     `cells`) goes to a cluster of its block and side within a voxel of it, the one whose plane lies nearest; else
     (a texel in a voxel that the geometry around it claims for another side: a floor's edge at a wall) to the
     nearest cluster facing its way. A record that faces nothing (a sunlit roof's top) leaves the scene, whatever

@@ -88,8 +88,8 @@ def test_flux_on_a_walls_outside_stays_out_however_near_an_inside_surface_faces_
     it (y index 29, its voxels' mean normal mostly +y, toward the wall, and a little up: the sofa's top shares
     them): both in one block, on the same side key (+y). A sunlit record on the
     wall's outside (facing +y, in the wall's voxel) is outside the room: nothing lies before it, so it leaves the
-    scene — it must not go to the sofa's back, the nearest +y cluster within a voxel (which it did:
-    a window room's first bounce was 2.7× what its window lets in). A record on the sofa's back goes there."""
+    scene — it must not go to the sofa's back, the nearest +y cluster within a voxel (which it did before
+    own_side). A record on the sofa's back goes there."""
     wall = _plane(1, 30, (0, 0), (40, 27), sign=-1.0)
     sofa = _plane(1, 29, (10, 0), (30, 8), sign=1.0)
     sofa[1][:] = (0.0, 0.94, 0.34)
