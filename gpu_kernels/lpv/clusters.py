@@ -196,8 +196,9 @@ def own_side(clusters: Clusters, cells: np.ndarray, normals: np.ndarray, pos: np
     f = np.floor((pos - np.asarray(clusters.fine.origin)) / clusters.fine.cell).astype(np.int64)
     want = (f[:, 2] * ny + f[:, 1]) * nx + f[:, 0]
     r = order[np.minimum(np.searchsorted(lin[order], want), len(lin) - 1)]
-    hit = np.all((f >= 0) & (f < (nx, ny, nz)), axis=1) & (lin[r] == want) & (np.linalg.norm(normals[r], axis=1) > 0)
-    facing = np.einsum("ij,ij->i", normals[r], normal) / np.maximum(np.linalg.norm(normals[r], axis=1), 1e-30)
+    length = np.linalg.norm(normals[r], axis=1)
+    facing = np.einsum("ij,ij->i", normals[r], normal) / np.maximum(length, 1e-30)
+    hit = np.all((f >= 0) & (f < (nx, ny, nz)), axis=1) & (lin[r] == want) & (length > 0)
     hit &= np.abs(facing) >= OWN_ALIGN
     c = clusters.side_cluster[r, (facing < 0).astype(np.int64)]
     out[hit] = np.where(c[hit] >= 0, c[hit], -2)
@@ -210,8 +211,9 @@ def bin_flux(clusters: Clusters, records: np.ndarray, cells: np.ndarray | None =
     the cluster of its own voxel's side that faces its way (own_side), or leaves the scene where that side faces
     nothing: a record on the outside of a room's wall is not the inside's, however near a cluster of the room that
     faces its way lies (a sofa's back inside the wall, a corner voxel that also holds the ceiling's inside: in the
-    window room, lit by its sun alone, 5 W of the 9 W binned came from the sunlit outside). A record whose voxel holds no surface (or any record, without
-    `cells`) goes to a cluster of its block and side within a voxel of it, the one whose plane lies nearest; else
+    window room, lit by its sun alone, 5 W of the 9 W binned came from the sunlit outside). A record whose voxel
+    holds no surface (or any record, without `cells`: the unit tests of the fallback) goes to a cluster of its
+    block and side within a voxel of it, the one whose plane lies nearest; else
     (a texel in a voxel that the geometry around it claims for another side: a floor's edge at a wall) to the
     nearest cluster facing its way. A record that faces nothing (a sunlit roof's top) leaves the scene, whatever
     voxel side it shares with other surfaces. Returns ((C, 3), the flux that leaves)."""

@@ -23,7 +23,7 @@
 // The result is added, per side, to what lpv/absorb.glsl found (zeros: world light is the sky light's VPLs), so the flux
 // lookup (lpv/lighting.glsl, MODE_FLUX) reads it unchanged; the next bounce's VPLs come from it (lpv/cluster.glsl).
 #include "lpv/common.glsl"
-#include "common/polygon.glsl"  // lambert_edge
+#include "common/polygon.glsl"  // clip_quad, quad_projected_solid_angle
 
 layout(local_size_x = 64) in;
 #include "common/structs.glsl"
@@ -122,35 +122,13 @@ float transmittance(vec3 from, vec3 dir, float dist) {
 }
 
 #if defined(MODE_TRANSFER)
-vec3 cut(vec3 a, vec3 b, float ha, float hb) {  // where edge a→b crosses the plane (heights ha < 0 ≤ hb or back)
-    return a + (b - a) * (ha / (ha - hb));
-}
-
-// The part of quad q0…q3 above a plane (corner heights u), as a quad: where no corner or two adjacent ones lie below
-// (a plane across the rectangle's axis: a wall standing on a floor's rectangle); false for a triangle or pentagon.
-bool clip_quad(inout vec3 q0, inout vec3 q1, inout vec3 q2, inout vec3 q3, vec4 u) {
-    bvec4 below = lessThan(u, vec4(0.0));
-    if (!any(below)) return true;
-    vec3 r0 = q0, r1 = q1, r2 = q2, r3 = q3;
-    if (below == bvec4(true, true, false, false)) { q0 = cut(r0, r3, u.x, u.w); q1 = cut(r1, r2, u.y, u.z); }
-    else if (below == bvec4(false, true, true, false)) { q1 = cut(r1, r0, u.y, u.x); q2 = cut(r2, r3, u.z, u.w); }
-    else if (below == bvec4(false, false, true, true)) { q2 = cut(r2, r1, u.z, u.y); q3 = cut(r3, r0, u.w, u.x); }
-    else if (below == bvec4(true, false, false, true)) { q3 = cut(r3, r2, u.w, u.z); q0 = cut(r0, r1, u.x, u.y); }
-    else return false;
-    return true;
-}
-
-float quad_psa(vec3 q0, vec3 q1, vec3 q2, vec3 q3, vec3 n) {  // Lambert's formula over a quad's four edges
-    return abs(lambert_edge(q0, q1, n) + lambert_edge(q1, q2, n) + lambert_edge(q2, q3, n)
-               + lambert_edge(q3, q0, n)) * 0.5;
-}
-
 // Near a cluster that lies in an axis plane (a wall's, a floor's): the exact irradiance per watt of a Lambertian
 // rectangle of uniform radiance Φ/(π·A) spanning its voxels in that plane — Lambert's formula over its edges
-// (common/polygon.glsl lambert_edge), each side of the receiver seeing the part above its plane. A receiver beside
-// a wall's edge gets half its irradiance from the floor right next to it; the quarter discs below, 1–2 cells out,
-// gave edges 0.7–0.9 of it in a closed box. False where a side sees a triangle or a pentagon of it (the quarter
-// discs then): clipping those needs arrays, which llvmpipe keeps in memory for the whole shader (2.5× slower).
+// (common/polygon.glsl clip_quad, quad_projected_solid_angle), each side of the receiver seeing the part above its
+// plane. A receiver beside a wall's edge gets half its irradiance from the floor right next to it; the quarter
+// discs below, 1–2 cells out, gave edges 0.7–0.9 of it in a closed box. False where a side sees a triangle or a
+// pentagon of it (the quarter discs then): clipping those needs arrays, which llvmpipe keeps in memory for the
+// whole shader (2.5× slower).
 bool rectangle_kernel(int j, Vpl v, vec3 p, vec3 nv, float h, out vec2 k) {
     vec3 a = abs(v.normal.xyz);
     vec3 ea = a.x >= a.y ? (a.x >= a.z ? vec3(1, 0, 0) : vec3(0, 0, 1)) : (a.y >= a.z ? vec3(0, 1, 0) : vec3(0, 0, 1));
@@ -165,7 +143,8 @@ bool rectangle_kernel(int j, Vpl v, vec3 p, vec3 nv, float h, out vec2 k) {
     bool front = any(greaterThan(up, vec4(0.0))), back = any(lessThan(up, vec4(0.0)));
     if ((front && !clip_quad(f0, f1, f2, f3, up)) || (back && !clip_quad(q0, q1, q2, q3, -up))) return false;
     float area = dot(hi - lo, eb) * dot(hi - lo, ec);
-    k = vec2(front ? quad_psa(f0, f1, f2, f3, nv) : 0.0, back ? quad_psa(q0, q1, q2, q3, -nv) : 0.0) / (PI * area);
+    k = vec2(front ? quad_projected_solid_angle(f0, f1, f2, f3, nv) : 0.0,
+             back ? quad_projected_solid_angle(q0, q1, q2, q3, -nv) : 0.0) / (PI * area);
     return true;
 }
 #endif
