@@ -6,6 +6,12 @@
 
 const float PI = 3.14159265358979;
 
+// Smith's Λ for GGX (Heitz 2014, "Understanding the masking-shadowing function"): G2 = 1 / (1 + Λ(μ_v) + Λ(μ_l)).
+float ggx_lambda(float alpha2, float mu) {
+    float tan2 = max(1.0 / max(mu * mu, 1e-12) - 1.0, 0.0);
+    return 0.5 * (sqrt(1.0 + alpha2 * tan2) - 1.0);
+}
+
 // Cycles (kernel/light/spot.h): smoothstep(0, 1, (cos α − cos(half size)) · smooth), smooth = 1/((1−cos half)·blend);
 // `dir` is the unit direction from the light to the point.
 float spot_attenuation(GpuLight L, vec3 dir) {

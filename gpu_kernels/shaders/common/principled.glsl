@@ -44,30 +44,41 @@ float fresnel_dielectric(float cos_i, float eta) {
     return 0.5 * a * a * (1.0 + b * b);
 }
 
+// A material's glossy closures at one μ (its rows of the table), for glossy_fresnel_at over many h·v.
+struct GlossyFresnel {
+    vec4 a, b, c, d, e;
+    vec3 base;
+};
+
+GlossyFresnel glossy_fresnel_rows(sampler2D lut, int material, float mu, vec3 base) {
+    return GlossyFresnel(principled_row(lut, 5 * material, mu), principled_row(lut, 5 * material + 1, mu),
+                         principled_row(lut, 5 * material + 2, mu), principled_row(lut, 5 * material + 3, mu),
+                         principled_row(lut, 5 * material + 4, mu), base);
+}
+
 // Σ over the glossy closures of weight × darkening × F(h·v), for Glossy Direct (direct/ggx.glsl): the metal's
 // F82-tint (white tint: Schlick with F0 = the base colour) and the dielectric layer's F0 × tint blended to 1 by the
 // real dielectric Fresnel, as Cycles' generalised Schlick does; each is its Glossy Color share times F(h·v)/F̄, so
 // averaged over the lobe it gives back Glossy Color. (The coat's share is scaled like the layer's.)
-vec3 principled_glossy_fresnel(sampler2D lut, int material, float mu, vec3 base, float hv) {
-    vec4 a = principled_row(lut, 5 * material, mu);
-    vec4 b = principled_row(lut, 5 * material + 1, mu);
-    vec4 c = principled_row(lut, 5 * material + 2, mu);
-    vec4 d = principled_row(lut, 5 * material + 3, mu);
-    vec4 e = principled_row(lut, 5 * material + 4, mu);
+vec3 glossy_fresnel_at(GlossyFresnel f, float hv) {
     vec3 k = vec3(0.0);
-    if (e.x != 1.0) {
-        float s = clamp((fresnel_dielectric(hv, e.x) - e.y) / (1.0 - e.y), 0.0, 1.0);
-        k += b.rgb * mix(d.rgb, vec3(1.0), s) / max(mix(d.rgb, vec3(1.0), d.a), vec3(1e-6));
+    if (f.e.x != 1.0) {
+        float s = clamp((fresnel_dielectric(hv, f.e.x) - f.e.y) / (1.0 - f.e.y), 0.0, 1.0);
+        k += f.b.rgb * mix(f.d.rgb, vec3(1.0), s) / max(mix(f.d.rgb, vec3(1.0), f.d.a), vec3(1e-6));
     } else {
-        k += b.rgb;  // the coat alone
+        k += f.b.rgb;  // the coat alone
     }
-    if (max(c.r, max(c.g, c.b)) > 0.0) {
-        vec3 f0 = clamp(base, 0.0, 1.0);
+    if (max(f.c.r, max(f.c.g, f.c.b)) > 0.0) {
+        vec3 f0 = clamp(f.base, 0.0, 1.0);
         vec3 fss = mix(f0, vec3(1.0), 1.0 / 21.0);
-        vec3 fms = fss * c.a / (vec3(1.0) - fss * (1.0 - c.a));
-        k += c.rgb * (vec3(a.a) + fms * (1.0 - a.a)) * mix(f0, vec3(1.0), pow(1.0 - clamp(hv, 0.0, 1.0), 5.0));
+        vec3 fms = fss * f.c.a / (vec3(1.0) - fss * (1.0 - f.c.a));
+        k += f.c.rgb * (vec3(f.a.a) + fms * (1.0 - f.a.a)) * mix(f0, vec3(1.0), pow(1.0 - clamp(hv, 0.0, 1.0), 5.0));
     }
     return k;
+}
+
+vec3 principled_glossy_fresnel(sampler2D lut, int material, float mu, vec3 base, float hv) {
+    return glossy_fresnel_at(glossy_fresnel_rows(lut, material, mu, base), hv);
 }
 
 // E(μ): the GGX lobe's albedo with Fresnel 1 at the material's roughness (Cycles' energy_scale is 1/E).

@@ -107,31 +107,32 @@ float polygon_visibility(GpuLight L, vec3 p, vec3 n, vec3 geo_n) {
     return wsum > 0.0 ? vsum / wsum : 1.0;
 }
 
-// Visibility of the sky light from its K directions d_k (ShadowView.emitter: d_k and its solid angle): the share of
-// the weight w_k of the directions that reach the sky. x: w_k = max(0, n·d_k), the cosine, for irradiance; y (when
-// `lobe`): the glossy lobe about the mirror direction r, a von Mises–Fisher weight exp(κ(r·d − 1)) whose width is
-// the lobe's (GGX α: an angular spread of about 2α about r after reflection) widened to the spacing of the
-// directions (4π/K each), so a mirror still averages its few nearest directions rather than one. Both shares come
-// from one shadow test per direction. A quadrature over the sphere of the visible share of the world; each
-// direction's map holds the scene's own triangles, so thin and one-sided walls block exactly.
-vec2 sky_shares(GpuLight L, vec3 p, vec3 n, vec3 geo_n, vec3 r, float alpha, bool lobe) {
+// Direction k of the sky light (ShadowView.emitter: d_k and its solid angle) as a surface of geometric normal
+// geo_n sees it: false for directions below the surface (they see its back) and grazing ones (cos < 0.1: 1% of the
+// irradiance), which would need an offset larger than a thin wall is thick; those take the others' mean (left out
+// of both the weights and the visible sum).
+bool sky_direction(GpuLight L, int k, vec3 geo_n, out vec3 d) {
+    d = shadow_views[int(L.params.y) + k].emitter.xyz;
+    return dot(geo_n, d) >= 0.1;
+}
+
+// Visibility of the sky light from its K directions d_k: the share of the cosine weight max(0, n·d_k) of the
+// directions that reach the sky, one shadow test per direction (direct/light.glsl adds the glossy lobe's share to
+// the same tests). A quadrature over the sphere of the visible share of the world; each direction's map holds the
+// scene's own triangles, so thin and one-sided walls block exactly.
+float sky_visibility(GpuLight L, vec3 p, vec3 n, vec3 geo_n) {
     int samples = int(L.params.z);
-    if (samples == 0) return vec2(1.0);
-    int first = int(L.params.y);
-    float kappa = 1.0 / (4.0 * alpha * alpha + 4.0 * PI / float(samples));
-    vec2 wsum = vec2(0.0), vsum = vec2(0.0);
+    if (samples == 0) return 1.0;
+    float wsum = 0.0, vsum = 0.0;
     for (int k = 0; k < samples; k += max(u_sky_stride, 1)) {
-        vec3 d = shadow_views[first + k].emitter.xyz;
-        // Directions below the surface see its back; grazing ones (cos < 0.1: 1% of the irradiance) would need
-        // an offset larger than a thin wall is thick, so they take the others' mean (left out of both sums).
-        if (dot(geo_n, d) < 0.1) continue;
-        vec2 w = vec2(max(dot(n, d), 0.0), lobe ? exp(kappa * (dot(r, d) - 1.0)) : 0.0);
-        w *= vec2(greaterThan(w, vec2(1e-4)));
-        if (max(w.x, w.y) <= 0.0) continue;
+        vec3 d;
+        if (!sky_direction(L, k, geo_n, d)) continue;
+        float w = max(dot(n, d), 0.0);
+        if (w <= 1e-4) continue;
         wsum += w;
-        vsum += w * view_visibility_biased(first + k, p, geo_n, d, 0.0);
+        vsum += w * view_visibility_biased(int(L.params.y) + k, p, geo_n, d, 0.0);
     }
-    return vec2(wsum.x > 0.0 ? vsum.x / wsum.x : 0.0, wsum.y > 0.0 ? vsum.y / wsum.y : 0.0);
+    return wsum > 0.0 ? vsum / wsum : 0.0;
 }
 
 // Unshadowed direct irradiance of one light at p (normal n).
@@ -162,7 +163,7 @@ float light_visibility(GpuLight L, vec3 p, vec3 n, vec3 geo_n) {
     if (type == LIGHT_SUN) return view_visibility(int(L.params.y), p, geo_n, -L.direction.xyz);
     if (type == LIGHT_POINT) return cube_visibility(int(L.params.y), p, geo_n);
     if (type == LIGHT_SPOT) return view_visibility(int(L.params.y), p, geo_n, normalize(L.position.xyz - p));
-    if (type == LIGHT_SKY) return sky_shares(L, p, n, geo_n, n, 0.0, false).x;
+    if (type == LIGHT_SKY) return sky_visibility(L, p, n, geo_n);
     return polygon_visibility(L, p, n, geo_n);
 }
 

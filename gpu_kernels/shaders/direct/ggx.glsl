@@ -11,11 +11,6 @@
 
 #define GLOSSY_POLYGON_SAMPLES 24  // quadrature points per polygon light (at least one per fan triangle)
 
-float ggx_lambda(float alpha2, float mu) {
-    float tan2 = max(1.0 / max(mu * mu, 1e-12) - 1.0, 0.0);
-    return 0.5 * (sqrt(1.0 + alpha2 * tan2) - 1.0);
-}
-
 // The surface's glossy lobe: roughness α, its material's rows in `lut`, μ = n·v, base colour.
 struct GlossyLobe {
     float alpha;
@@ -35,6 +30,19 @@ vec3 lobe_cos(sampler2D lut, GlossyLobe g, vec3 n, vec3 v, vec3 l) {
     float d = a2 / (PI * t * t);
     float g2 = 1.0 / (1.0 + ggx_lambda(a2, g.mu) + ggx_lambda(a2, mu_l));
     return principled_glossy_fresnel(lut, g.material, g.mu, g.base, dot(h, v)) * (d * g2 / (4.0 * g.mu));
+}
+
+// The weight of sky direction d in the glossy lobe's share of the sky (direct/light.glsl): the lobe's own
+// f(v, d)·cosθ_d up to a constant, GGX D(h)/D(n) = (α²/t)² with Smith's G2 and the closures' Fresnel at h·v
+// (`fresnel`: glossy_fresnel_rows at the lobe's μ). `a2`: α² widened to the directions' spacing by the caller.
+float sky_lobe_weight(GlossyLobe g, GlossyFresnel fresnel, float a2, vec3 n, vec3 v, vec3 d) {
+    float mu_l = dot(n, d);
+    if (g.mu <= 0.0 || mu_l <= 0.0) return 0.0;
+    vec3 h = normalize(v + d);
+    float c2 = min(dot(n, h) * dot(n, h), 1.0);
+    float t = 1.0 - c2 + a2 * c2;
+    float g2 = 1.0 / (1.0 + ggx_lambda(a2, g.mu) + ggx_lambda(a2, mu_l));
+    return (a2 / t) * (a2 / t) * g2 * dot(glossy_fresnel_at(fresnel, dot(h, v)), vec3(1.0 / 3.0));
 }
 
 // Σ over quadrature points of the polygon: radiance × f·cosθ_l × cosθ_emitter·dA / d². The polygon is read as

@@ -25,6 +25,28 @@ uniform bool u_ortho;
 uniform int u_light_count;
 uniform ivec2 u_size;
 
+// The sky light's visible shares at p, from one shadow test per direction (direct/eval.glsl sky_direction): x of
+// the cosine weight (irradiance), y (when `lobe_seen`) of the glossy lobe's (direct/ggx.glsl sky_lobe_weight). The
+// lobe's α² is widened by SKY_LOBE_SPREAD / K so that a mirror still averages its few nearest directions rather
+// than one.
+#define SKY_LOBE_SPREAD 2.0
+vec2 sky_shares(GpuLight L, vec3 p, vec3 n, vec3 geo_n, GlossyLobe lobe, vec3 v, bool lobe_seen) {
+    int samples = int(L.params.z);
+    if (samples == 0) return vec2(1.0);
+    float a2 = lobe.alpha * lobe.alpha + SKY_LOBE_SPREAD / float(samples);
+    GlossyFresnel fresnel = glossy_fresnel_rows(u_material_lut, lobe.material, lobe.mu, lobe.base);
+    vec2 wsum = vec2(0.0), vsum = vec2(0.0);
+    for (int k = 0; k < samples; k += max(u_sky_stride, 1)) {
+        vec3 d;
+        if (!sky_direction(L, k, geo_n, d)) continue;
+        vec2 w = vec2(max(dot(n, d), 0.0), lobe_seen ? sky_lobe_weight(lobe, fresnel, a2, n, v, d) : 0.0);
+        if (max(w.x, w.y) <= 0.0) continue;
+        wsum += w;
+        vsum += w * view_visibility_biased(int(L.params.y) + k, p, geo_n, d, 0.0);
+    }
+    return vec2(wsum.x > 0.0 ? vsum.x / wsum.x : 0.0, wsum.y > 0.0 ? vsum.y / wsum.y : 0.0);
+}
+
 void main() {
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(px, u_size))) return;
@@ -47,7 +69,7 @@ void main() {
             // The world: irradiance π·L and, for any roughness, its reflection L (Glossy Color divided out; Cycles
             // counts the world a mirror shows as direct light too), each times its share of the sky that is seen.
             bool lobe_seen = has_glossy && lobe.mu > 0.0;
-            vec2 shares = sky_shares(lights[i], pos.xyz, n, geo_n, 2.0 * lobe.mu * n - v, lobe.alpha, lobe_seen);
+            vec2 shares = sky_shares(lights[i], pos.xyz, n, geo_n, lobe, v, lobe_seen);
             irradiance += light_unshadowed(lights[i], pos.xyz, n) * shares.x;
             if (lobe_seen) world += lights[i].color_type.rgb * shares.y;
             continue;
