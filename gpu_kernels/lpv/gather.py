@@ -144,7 +144,8 @@ def bounce_vpls(ctx, programs, state: LpvGridState, gv, budget: int) -> VplList:
     VPLs: S×S×S voxel blocks, up to three per block split by plane (lpv/cluster.glsl), S from 2 up."""
     prog = programs.compute("lpv/cluster.glsl")
     bind_named(prog, [("u_front", state.front), ("u_back", state.back), ("u_voxel_normal", gv.normal),
-                      ("u_voxel_area", gv.area), ("u_voxel_albedo", gv.albedo)])
+                      ("u_voxel_area", gv.area), ("u_voxel_albedo", gv.albedo),
+                      ("u_voxel_albedo_back", gv.albedo_back or gv.albedo)])
     set_uniform(prog, "u_fine_origin", tuple(float(c) for c in gv.fine.origin))
     set_uniform(prog, "u_fine_size", tuple(gv.fine.size))
     set_uniform(prog, "u_voxel", float(gv.fine.cell))

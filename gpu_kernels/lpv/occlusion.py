@@ -29,10 +29,14 @@ class GeometryVolume:
     cells: np.ndarray | None = None  # (R, 3) xyz of those voxels, in the buffer's order
     surface_normal: np.ndarray | None = None  # (R, 3) their mean normals (not renormalised)
     surface_area: np.ndarray | None = None  # (R,) their surface areas (m²)
-    surface_albedo: np.ndarray | None = None  # (R, 3) their albedo, from the materials they were voxelised with
+    # (2, R, 3) their front and back side's albedo (voxelize sides=True: a rug's colour on the side it covers a
+    # floor from), from the materials they were voxelised with
+    surface_albedo: np.ndarray | None = None
+    albedo_back: object = None  # the back side's albedo texture (None: `albedo` serves both sides)
 
     def release(self):
-        for t in (self.blocking, self.area, self.normal, self.albedo, self.coverage, self.layers, self.surfaces):
+        for t in (self.blocking, self.area, self.normal, self.albedo, self.coverage, self.layers, self.surfaces,
+                  self.albedo_back):
             if t is not None:
                 t.release()
 
@@ -133,13 +137,14 @@ def geometry_volumes(ctx, programs, scene: Scene, geometry, textures, grids: lis
     out = []
     for grid in grids:
         fine = Grid(tuple(np.asarray(grid.origin) - grid.cell / 2), grid.cell / 2, tuple(2 * n + 2 for n in grid.size))
-        vox = voxelize(ctx, programs, scene, geometry, textures, fine)
+        vox = voxelize(ctx, programs, scene, geometry, textures, fine, sides=True)
         arrays = vox.read()
         area = arrays["area"]
         blocking = face_blocking(area, grid)
         tex = ctx.texture3d(tuple(n + 1 for n in grid.size), 4, np.ascontiguousarray(blocking).tobytes(), dtype="f4")
-        for t in (tex, vox.area, vox.normal, vox.albedo):
-            t.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        for t in (tex, vox.area, vox.normal, vox.albedo, vox.albedo_back):
+            if t is not None:
+                t.filter = (moderngl.NEAREST, moderngl.NEAREST)
         crossings = [ctx.texture3d(tuple(grid.size), 4, a.tobytes(), dtype="f4")
                      for a in crossing_layers(area, arrays["normal"], grid)]
         for t in crossings:
@@ -153,20 +158,29 @@ def geometry_volumes(ctx, programs, scene: Scene, geometry, textures, grids: lis
         normals = arrays["normal"][z, y, x, :3]
         out.append(GeometryVolume(tex, fine, vox.area, vox.normal, vox.albedo, *crossings, surfaces, len(cells),
                                   cells[:, :3], normals, layer_area(area[z, y, x, 3], normals, fine.cell),
-                                  arrays["albedo"][z, y, x, :3]))
+                                  side_albedo(arrays, cells[:, :3]), albedo_back=vox.albedo_back))
     return out
 
 
+def side_albedo(arrays: dict, cells: np.ndarray) -> np.ndarray:
+    """(2, R, 3): the front and back side's albedo at `cells` (R, 3) xyz from VoxelVolumes.read() arrays (the
+    front's for both where the voxelisation kept one albedo)."""
+    x, y, z = cells.T
+    front = arrays["albedo"][z, y, x, :3]
+    back = arrays["albedo_back"][z, y, x, :3] if "albedo_back" in arrays else front
+    return np.stack([front, back])
+
+
 def surface_albedo(ctx, programs, scene: Scene, geometry, textures, gv: GeometryVolume) -> np.ndarray:
-    """(R, 3): the albedo of `gv`'s surface voxels under the scene's current materials — a voxelisation of the
-    same grid whose occupancy is discarded (a material edit changes no geometry: lpv/transfer.py)."""
+    """(2, R, 3): the two sides' albedo of `gv`'s surface voxels under the scene's current materials — a
+    voxelisation of the same grid whose occupancy is discarded (a material edit changes no geometry:
+    lpv/transfer.py)."""
     from ..voxel.voxelize import voxelize
 
-    vox = voxelize(ctx, programs, scene, geometry, textures, gv.fine)
-    albedo = vox.read()["albedo"]
+    vox = voxelize(ctx, programs, scene, geometry, textures, gv.fine, sides=True)
+    arrays = vox.read()
     vox.release()
-    x, y, z = gv.cells.T
-    return albedo[z, y, x, :3]
+    return side_albedo(arrays, gv.cells)
 
 
 def absorb(ctx, programs, state: LpvGridState, gv: GeometryVolume, add: bool) -> None:
@@ -195,7 +209,8 @@ def inject_bounce(ctx, programs, state: LpvGridState, gv: GeometryVolume, bound:
     state.accum_ints.clear()
     prog = programs.compute("lpv/bounce.glsl")
     bind_named(prog, [("u_front", state.front), ("u_back", state.back), ("u_voxel_normal", gv.normal),
-                      ("u_voxel_area", gv.area), ("u_voxel_albedo", gv.albedo)])
+                      ("u_voxel_area", gv.area), ("u_voxel_albedo", gv.albedo),
+                      ("u_voxel_albedo_back", gv.albedo_back or gv.albedo)])
     set_uniform(prog, "u_fine_origin", tuple(float(c) for c in gv.fine.origin))
     set_uniform(prog, "u_fine_size", tuple(gv.fine.size))
     bind_grid(prog, state.grid)

@@ -155,7 +155,7 @@ def _transfer_geometry(frame, grids, k_grids, budget) -> tuple:
                    and [t.grid for t in value] == list(grids)), [None] * len(gvs))
     transfers = cache.run("lpv_transfer", k_tr, lambda: [_build(ctx, programs, gv, grid, budget, s, p)
                                                          for gv, grid, p in zip(gvs, grids, priors)])
-    weights = [a * gv.surface_area[:, None] for a, gv in zip(albedo, gvs)]
+    weights = [a * gv.surface_area[None, :, None] for a, gv in zip(albedo, gvs)]  # (2, R, 3) per side
     k_m = (k_tr, k_albedo)
     reflection = cache.run("lpv_transfer_albedo", k_m, lambda: [
         transfer.bounded_transport(t, transfer.albedo_transfer(t, w), w) for t, w in zip(transfers, weights)])

@@ -106,6 +106,7 @@ def render_rsm(ctx, programs, scene: Scene, geometry, textures, shadows, resolut
         set_uniform(prog, "u_origin", tuple(float(c) for c in view.origin))
         set_uniform(prog, "u_forward", tuple(float(c) for c in -back))
         set_uniform(prog, "u_ortho", bool(view.ortho))
+        set_uniform(prog, "u_far", 0.0 if view.ortho else float(view.far))
         set_uniform(prog, "u_view_index", float(i))
         draw_by_material(prog, scene, geometry, textures, vao=vao)
         light = view_lights[i]

@@ -200,7 +200,8 @@ def bounded_transport(t: Transfer, m_rho: np.ndarray, weight: np.ndarray) -> tup
     scatter around one watt (0.8 to 1.4): capping those would darken them (furnished's Combined 0.10 → 0.14), so
     the cap applies only where r shows the operator is impossible."""
     areas = np.asarray(t.areas, np.float64)
-    rho = (np.asarray(weight, np.float64) / np.maximum(areas[:, None], 1e-30)).max(axis=0, initial=0.0)
+    per_area = side_weights(weight) / np.maximum(areas[None, :, None], 1e-30)
+    rho = per_area.reshape(-1, per_area.shape[-1]).max(axis=0, initial=0.0)
     if all(spectral_radius(m_rho[ch]) <= rho[ch] for ch in range(m_rho.shape[0])):
         return m_rho, None
     delivered = sum(t.matrix[side].astype(np.float64) @ areas[t.order[side]]
@@ -209,14 +210,21 @@ def bounded_transport(t: Transfer, m_rho: np.ndarray, weight: np.ndarray) -> tup
     return m_rho * gain[None, None, :], gain
 
 
+def side_weights(weight: np.ndarray) -> np.ndarray:
+    """albedo × area per receiver side, (2, R, 3) float64, from (2, R, 3) or one (R, 3) for both sides."""
+    w = np.asarray(weight, np.float64)
+    return np.broadcast_to(w, (2,) + w.shape) if w.ndim == 2 else w
+
+
 def albedo_transfer(t: Transfer, weight: np.ndarray) -> np.ndarray:
     """M_ρ (3, C, C): M[ch, c', c] = the flux cluster c' reflects in channel ch when cluster c emits one watt —
-    Σ over c'’s voxel sides of albedo × area × T, one small product per cluster and side over its contiguous
-    columns (all three channels at once: T is read once)."""
+    Σ over c'’s voxel sides of albedo × area × T (`weight`: side_weights), one small product per cluster and side
+    over its contiguous columns (all three channels at once: T is read once)."""
     count = t.clusters.count
+    weight = side_weights(weight)
     out = np.zeros((count, count, 3), np.float32)  # [c', c, ch]
     for side in range(2):
-        w = weight[t.order[side]].astype(np.float32)
+        w = weight[side][t.order[side]].astype(np.float32)
         starts = t.starts[side]
         for c in range(count):
             a, b = starts[c], starts[c + 1]

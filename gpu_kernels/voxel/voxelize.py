@@ -10,6 +10,9 @@ Two methods, as compared in Freed 2018, §5.2.2 / Table 5.2:
     smaller than 1/supersample voxel; a geometry shader deposits each at its centroid, with its exact area.
     Triangles needing a level above GL_MAX_TESS_GEN_LEVEL are split on the CPU first (`split_for_tessellation`).
 
+With ``sides=True`` (raster only) the albedo is kept per side of each voxel, covered surfaces left out of the side
+they are hidden from (voxel/raster.glsl): `VoxelVolumes.albedo_back` holds the back side's.
+
 Averages are race-free and deterministic: every quantity is summed with integer ``imageAtomicAdd`` in fixed
 point (1 unit = 2^-scale_bits cell², default 2^-24: a voxel holds up to 256 cell² of surface; the shader flags a
 wrapped sum and `voxelize` re-runs with fewer bits), then a compute pass divides (voxel/resolve.glsl).
@@ -25,7 +28,7 @@ import numpy as np
 from ..common.grid import Grid
 from ..direct.geometry import bind_material
 from ..gl import preprocessor as spp
-from ..gl.bind import bind_images, bind_named, dispatch, set_uniform, set_uniforms
+from ..gl.bind import bind_images, bind_named, dispatch, set_uniform, set_uniforms, zero_texture
 from ..scene import Scene
 
 MODES = ("raster", "tessellation")
@@ -34,6 +37,7 @@ MAX_TESS_LEVEL = 64          # GL_MAX_TESS_GEN_LEVEL is at least 64 everywhere (
 TESS_VERTEX_BUDGET = 16384   # tessellated vertices per draw call (half of what llvmpipe handles, see below)
 DILATION_PX = 0.5 + 1.0 / 64.0   # half a pixel, plus slack for the rasteriser's 1/256-pixel vertex snapping
 VOLUME_NAMES = ("area", "albedo", "normal", "emission")
+SIDES_BYTES = 256 * 2 ** 20  # the front-most image's budget for sides=True; larger grids keep one albedo
 
 
 @dataclass
@@ -43,7 +47,9 @@ class VoxelVolumes:
     area: rgb = projected area onto the x/y/z planes (m²), a = surface area (m²);
     albedo: rgb = area-weighted mean albedo (voxel_albedo: diffuse and glossy reflectance), a = opacity = min(1, max projected area / cell²);
     normal: xyz = area-weighted mean sign-canonicalised geometric normal (not renormalised), w = 0;
-    emission: rgb = area-weighted mean emitted radiance.
+    emission: rgb = area-weighted mean emitted radiance;
+    albedo_back (sides=True): rgb = the back side's mean albedo (the side opposite the mean normal), albedo's rgb
+    then the front side's; None where not asked for or over SIDES_BYTES (one albedo serves both sides).
     """
     grid: Grid
     area: object
@@ -54,9 +60,13 @@ class VoxelVolumes:
     supersample: int
     scale_bits: int          # fixed-point bits actually used
     reruns: int = 0          # re-runs after a fixed-point overflow (0 normally)
+    albedo_back: object = None
 
     def textures(self) -> dict:
-        return {name: getattr(self, name) for name in VOLUME_NAMES}
+        out = {name: getattr(self, name) for name in VOLUME_NAMES}
+        if self.albedo_back is not None:
+            out["albedo_back"] = self.albedo_back
+        return out
 
     def read(self) -> dict:
         """{name: (nz, ny, nx, 4) float32} — call on the GL thread (e.g. inside ``Engine().worker.call``)."""
@@ -75,7 +85,7 @@ class VoxelVolumes:
 
 
 def voxelize(ctx, programs, scene: Scene, geometry, textures, grid: Grid, mode: str = "raster",
-             supersample: int = 2, scale_bits: int = DEFAULT_SCALE_BITS) -> VoxelVolumes:
+             supersample: int = 2, scale_bits: int = DEFAULT_SCALE_BITS, sides: bool = False) -> VoxelVolumes:
     """Voxelise the scene's surfaces into `grid` (GL thread); returns new textures the caller releases.
 
     `geometry`: direct/geometry.GeometryBuffers of `scene` (raster draws its VBO; tessellation uploads its own patch
@@ -83,6 +93,7 @@ def voxelize(ctx, programs, scene: Scene, geometry, textures, grid: Grid, mode: 
     direct/geometry.upload_textures. `supersample`: raster — pixels per voxel edge, i.e. texture samples per voxel face
     (areas are exact at any value); tessellation — sub-triangles per voxel edge. `scale_bits`: fixed-point
     fraction bits (1 unit = 2^-bits cell²); lowered automatically, and reported, if a voxel's sum would wrap.
+    `sides`: keep the albedo per side, covered surfaces left out of the side they are hidden from (raster only).
     """
     import moderngl
 
@@ -91,11 +102,14 @@ def voxelize(ctx, programs, scene: Scene, geometry, textures, grid: Grid, mode: 
     nx, ny, nz = grid.size
     used = sorted({m for m, _, _ in geometry.ranges})
     albedo_max, emission_max = material_maxima(scene, used, textures.transport)
-    accs = [ctx.texture3d((4 * nx, ny, nz), 1, dtype="u4") for _ in range(4)]
+    sides = bool(sides) and mode == "raster" and front_bytes(grid, supersample) <= SIDES_BYTES and \
+        2 * sum(grid.size) <= int(ctx.info.get("GL_MAX_3D_TEXTURE_SIZE", 2048))
+    accs = [ctx.texture3d((4 * nx, ny, nz), 1, dtype="u4") for _ in range(5 if sides else 4)]
     flags = ctx.texture3d((1, 1, 1), 1, np.zeros(1, np.uint32).tobytes(), dtype="u4")
     for t in accs + [flags]:
         t.filter = (moderngl.NEAREST, moderngl.NEAREST)
     patches = _tessellation_buffers(ctx, scene, grid, supersample) if mode == "tessellation" else None
+    fronts = _front_most(ctx, programs, scene, geometry, textures, grid, supersample) if sides else []
     try:
         reruns = 0
         while True:
@@ -104,10 +118,11 @@ def voxelize(ctx, programs, scene: Scene, geometry, textures, grid: Grid, mode: 
             uniforms = {"u_grid_origin": grid.origin, "u_inv_cell": 1.0 / grid.cell, "u_grid_size": grid.size,
                         "u_supersample": float(supersample), "u_albedo_max": albedo_max,
                         "u_emission_max": emission_max, "u_fixed_scale": float(2.0 ** scale_bits)}
-            for unit, t in enumerate(accs + [flags]):
+            for unit, t in enumerate(accs[:4] + [flags] + accs[4:] + fronts):  # units of voxel/common.glsl
                 t.bind_to_image(unit, read=True, write=True)
             if mode == "raster":
-                _draw_raster(ctx, programs, scene, geometry, textures, grid, supersample, uniforms)
+                _draw_raster(ctx, programs, scene, geometry, textures, grid, supersample, uniforms,
+                             {"SIDES": None} if sides else None)
             else:
                 _draw_tessellated(ctx, programs, scene, patches, textures, uniforms)
             ctx.memory_barrier()
@@ -118,11 +133,35 @@ def voxelize(ctx, programs, scene: Scene, geometry, textures, grid: Grid, mode: 
             reruns += 1
         volumes = _resolve(ctx, programs, accs, grid, scale_bits, albedo_max, emission_max)
     finally:
-        for t in accs + [flags]:
+        for t in accs + [flags] + fronts:
             t.release()
         if patches is not None:
             patches[0].release()
-    return VoxelVolumes(grid, *volumes, mode=mode, supersample=supersample, scale_bits=scale_bits, reruns=reruns)
+    return VoxelVolumes(grid, *volumes[:4], mode=mode, supersample=supersample, scale_bits=scale_bits,
+                        reruns=reruns, albedo_back=volumes[4] if sides else None)
+
+
+def front_bytes(grid: Grid, supersample: int) -> int:
+    """Bytes of the front-most image of sides=True: (side, side, 2·(nx + ny + nz)) uints, side = the raster's."""
+    side = int(max(grid.size)) * int(supersample)
+    return side * side * 2 * int(sum(grid.size)) * 4
+
+
+def _front_most(ctx, programs, scene, geometry, textures, grid, supersample) -> list:
+    """The MODE_FRONT pass of voxel/raster.glsl: an r32ui image of the front-most depth per pixel column, voxel
+    layer and side, the three axes' layers one after the other (a list of it; the caller releases it)."""
+    import moderngl
+
+    side = int(max(grid.size)) * int(supersample)
+    front = ctx.texture3d((side, side, 2 * int(sum(grid.size))), 1, dtype="u4")
+    front.filter = (moderngl.NEAREST, moderngl.NEAREST)
+    zero_texture(ctx, front)
+    front.bind_to_image(6, read=True, write=True)
+    uniforms = {"u_grid_origin": grid.origin, "u_inv_cell": 1.0 / grid.cell, "u_grid_size": grid.size,
+                "u_supersample": float(supersample)}
+    _draw_raster(ctx, programs, scene, geometry, textures, grid, supersample, uniforms, {"MODE_FRONT": None})
+    ctx.memory_barrier()
+    return [front]
 
 
 def _check_grid(ctx, grid: Grid, mode: str, supersample) -> None:
@@ -245,15 +284,17 @@ def _tessellation_buffers(ctx, scene: Scene, grid: Grid, supersample: int):
     return ctx.buffer(data.tobytes() or b"\0" * 44), ranges
 
 
-def _draw_raster(ctx, programs, scene, geometry, textures, grid, supersample, uniforms) -> None:
+def _draw_raster(ctx, programs, scene, geometry, textures, grid, supersample, uniforms, defines=None) -> None:
     import moderngl
 
-    prog = programs.raster("voxel/raster.glsl")
+    prog = programs.raster("voxel/raster.glsl", defines)
     side = max(grid.size) * supersample
     set_uniforms(prog, {**uniforms, "u_viewport": (float(side), float(side)), "u_dilation": DILATION_PX,
                         "u_supersample_i": supersample})
     fbo = ctx.empty_framebuffer((side, side))
-    vao = ctx.vertex_array(prog, [(geometry.vbo, "3f 12x 2f 12x", "in_position", "in_uv")])
+    layout = (geometry.vbo, "3f 12x 2f 12x", "in_position", "in_uv") if "in_uv" in prog else \
+        (geometry.vbo, "3f 32x", "in_position")  # MODE_FRONT samples no texture
+    vao = ctx.vertex_array(prog, [layout])
     try:
         fbo.use()
         fbo.viewport = (0, 0, side, side)
@@ -312,7 +353,7 @@ def tessellation_program(programs, name: str, defines: dict | None = None):
 
 
 def _clear(ctx, programs, accs, grid) -> None:
-    prog = programs.compute("voxel/resolve.glsl", {"MODE_CLEAR": None})
+    prog = programs.compute("voxel/resolve.glsl", {"MODE_CLEAR": None, **({"SIDES": None} if len(accs) > 4 else {})})
     for unit, t in enumerate(accs):
         t.bind_to_image(unit, read=False, write=True)
     set_uniform(prog, "u_grid_size", grid.size)
@@ -322,10 +363,13 @@ def _clear(ctx, programs, accs, grid) -> None:
 
 
 def _resolve(ctx, programs, accs, grid, scale_bits, albedo_max, emission_max) -> list:
-    prog = programs.compute("voxel/resolve.glsl", {"MODE_RESOLVE": None})
+    """The volumes of VOLUME_NAMES, then albedo_back when `accs` has its fifth (sides) accumulator."""
+    sides = len(accs) > 4
+    prog = programs.compute("voxel/resolve.glsl", {"MODE_RESOLVE": None, **({"SIDES": None} if sides else {})})
     nx, ny, nz = grid.size
-    out = [ctx.texture3d((nx, ny, nz), 4, dtype="f4") for _ in VOLUME_NAMES]
-    bind_named(prog, list(zip(("u_acc_area", "u_acc_albedo", "u_acc_normal", "u_acc_emission"), accs)))
+    out = [ctx.texture3d((nx, ny, nz), 4, dtype="f4") for _ in range(len(VOLUME_NAMES) + sides)]
+    names = ("u_acc_area", "u_acc_albedo", "u_acc_normal", "u_acc_emission", "u_acc_albedo_back")
+    bind_named(prog, list(zip(names, accs)))
     bind_images(out)
     cell_area = grid.cell ** 2
     set_uniforms(prog, {"u_grid_size": grid.size, "u_unit_area": cell_area / 2.0 ** scale_bits, "u_cell_area": cell_area,

@@ -189,6 +189,32 @@ def test_albedo_emission_and_normal_are_area_weighted(gl):
         assert np.count_nonzero(data["area"][..., 3]) == 1
 
 
+def test_sides_keep_the_colour_each_side_of_a_voxel_sees(gl):
+    """sides=True: a white floor (z = 0.3) with a red rug 1 mm above its middle and a blue patch 1 mm below one
+    corner, in 1/8 m voxels. Where the rug lies, the voxels' front (+z, the canonical normal's side) sees the rug
+    alone and their back the floor; under the blue patch the front sees the floor and the back the patch; elsewhere
+    both sides see the floor. Areas, normals and the one-albedo mean (sides=False) are unchanged. Exact up to the
+    fixed point's rounding (1e-5)."""
+    white, red, blue = np.array([0.8] * 3), np.array([0.7, 0.1, 0.05]), np.array([0.05, 0.2, 0.6])
+    floor = quad([(0, 0, 0.3), (1, 0, 0.3), (1, 1, 0.3), (0, 1, 0.3)])
+    rug = quad([(0.25, 0.25, 0.301), (0.75, 0.25, 0.301), (0.75, 0.75, 0.301), (0.25, 0.75, 0.301)])
+    patch = quad([(0, 0, 0.299), (0.25, 0, 0.299), (0.25, 0.25, 0.299), (0, 0.25, 0.299)])
+    mats = [Material("white", tuple(white)), Material("red", tuple(red)), Material("blue", tuple(blue))]
+    scene = make_scene(np.concatenate([floor, rug, patch]), [0, 0, 1, 1, 2, 2], mats)
+    grid = Grid((0, 0, 0), 0.125, (8, 8, 8))
+    one, _ = run(gl, scene, grid, "raster")
+    both, _ = run(gl, scene, grid, "raster", sides=True)
+    k = 2  # the layer z in [0.25, 0.375)
+    np.testing.assert_array_equal(both["area"], one["area"])
+    np.testing.assert_array_equal(both["normal"], one["normal"])
+    front, back = both["albedo"][k, ..., :3], both["albedo_back"][k, ..., :3]  # (y, x, 3)
+    for (y, x), want_front, want_back in (((3, 3), red, white), ((1, 1), white, blue), ((1, 6), white, white)):
+        np.testing.assert_allclose(front[y, x], want_front, atol=1e-5)
+        np.testing.assert_allclose(back[y, x], want_back, atol=1e-5)
+    np.testing.assert_allclose(one["albedo"][k, 3, 3, :3], (red + white) / 2, atol=1e-5)  # equal areas, mixed
+    assert "albedo_back" not in one
+
+
 # --------------------------------------------------------------------------- (e) determinism
 
 @pytest.mark.parametrize("mode", MODES)

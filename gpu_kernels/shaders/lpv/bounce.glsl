@@ -9,7 +9,8 @@ uniform sampler3D u_front;          // last pass: irradiance of each fine voxel'
 uniform sampler3D u_back;
 uniform sampler3D u_voxel_normal;
 uniform sampler3D u_voxel_area;
-uniform sampler3D u_voxel_albedo;
+uniform sampler3D u_voxel_albedo;        // the front side's albedo (voxel/voxelize.py sides=True)
+uniform sampler3D u_voxel_albedo_back;   // the back side's
 uniform vec3 u_fine_origin;
 uniform ivec3 u_fine_size;
 uniform vec3 u_grid_origin;
@@ -23,9 +24,8 @@ void main() {
     vec3 nv = texelFetch(u_voxel_normal, f, 0).xyz;
     if (area <= 0.0 || dot(nv, nv) == 0.0) return;
     nv = normalize(nv);
-    vec3 albedo = texelFetch(u_voxel_albedo, f, 0).rgb;
     vec3 p = u_fine_origin + (vec3(f) + 0.5) * (0.5 * u_grid_cell);
     LpvGrid g = LpvGrid(u_grid_origin, u_grid_cell, u_grid_size);
-    inject_lambertian(g, p, nv, albedo * texelFetch(u_front, f, 0).rgb * area);
-    inject_lambertian(g, p, -nv, albedo * texelFetch(u_back, f, 0).rgb * area);
+    inject_lambertian(g, p, nv, texelFetch(u_voxel_albedo, f, 0).rgb * texelFetch(u_front, f, 0).rgb * area);
+    inject_lambertian(g, p, -nv, texelFetch(u_voxel_albedo_back, f, 0).rgb * texelFetch(u_back, f, 0).rgb * area);
 }

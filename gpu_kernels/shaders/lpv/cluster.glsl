@@ -15,7 +15,8 @@ uniform sampler3D u_front;          // last pass: irradiance of each fine voxel'
 uniform sampler3D u_back;
 uniform sampler3D u_voxel_normal;
 uniform sampler3D u_voxel_area;
-uniform sampler3D u_voxel_albedo;
+uniform sampler3D u_voxel_albedo;        // the front side's albedo (voxel/voxelize.py sides=True)
+uniform sampler3D u_voxel_albedo_back;   // the back side's
 uniform vec3 u_fine_origin;
 uniform ivec3 u_fine_size;
 uniform float u_voxel;              // fine voxel size (m)
@@ -42,11 +43,11 @@ void main() {
                 vec3 nv = texelFetch(u_voxel_normal, f, 0).xyz;
                 if (a.a <= 0.0 || dot(nv, nv) == 0.0) continue;
                 nv = normalize(nv);
-                vec3 albedo = texelFetch(u_voxel_albedo, f, 0).rgb;
                 vec3 p = u_fine_origin + (vec3(f) + 0.5) * u_voxel;
                 for (int side = 0; side < 2; ++side) {
                     vec3 n = side == 0 ? nv : -nv;
                     vec3 e = (side == 0 ? texelFetch(u_front, f, 0) : texelFetch(u_back, f, 0)).rgb;
+                    vec3 albedo = (side == 0 ? texelFetch(u_voxel_albedo, f, 0) : texelFetch(u_voxel_albedo_back, f, 0)).rgb;
                     vec3 phi = albedo * e * a.a;
                     float w = dot(phi, vec3(0.2126, 0.7152, 0.0722));  // Rec.709 luminance
                     if (w <= 0.0) continue;

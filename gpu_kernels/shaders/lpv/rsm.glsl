@@ -19,6 +19,10 @@ uniform vec3 u_origin;       // the view's eye (perspective)
 uniform vec3 u_forward;      // the view's axis (orthographic: the sun's direction)
 uniform bool u_ortho;
 uniform float u_view_index;
+// > 0 (perspective): the depth test compares radial distance / u_far, linear like the shadow maps' own
+// (direct/shadow_depth.glsl); the projective depth's steps at a few metres (near = far / 10⁴) are a millimetre,
+// and a rug lying 1 mm over a floor z-fought with it, the floor's colour showing through in patches.
+uniform float u_far;
 layout(location = 0) out vec4 out_position;  // xyz world position, w = view index + 1 (0: empty texel)
 layout(location = 1) out vec4 out_normal;    // xyz shading normal facing the light
 layout(location = 2) out vec4 out_albedo;    // rgb albedo (diffuse + glossy)
@@ -30,6 +34,7 @@ void main() {
     if (dot(geo_n, to_light) < 0.0) {  // two-sided: the side the light sees reflects
         n = -n;
     }
+    gl_FragDepth = u_far > 0.0 ? length(v_position - u_origin) / u_far : gl_FragCoord.z;
     out_position = vec4(v_position, u_view_index + 1.0);
     out_normal = vec4(n, 0.0);
     float mu = max(dot(n, to_light), 0.0);

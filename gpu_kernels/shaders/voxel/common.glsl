@@ -11,6 +11,8 @@
 //   acc_albedo:   A·albedo.rgb / u_albedo_max          (unsigned; .w unused)
 //   acc_normal:   A·n.xyz / 2                          (two's complement int in a uint; |Σ A n/2| < 2^31)
 //   acc_emission: A·emission.rgb / u_emission_max      (unsigned; .w unused)
+// With SIDES (voxel/voxelize.py sides=True) the albedo is kept per side of the voxel: acc_albedo holds what the
+// side its canonical normals point to sees (.w: the area seen from there), acc_albedo_back the other side's.
 // Every channel is rounded from a value ≤ the area value, and rounding is monotone, so no channel can exceed
 // the total-area channel: checking that one channel for wrap-around guards them all.
 #pragma once
@@ -30,6 +32,9 @@ layout(binding = 1, r32ui) uniform uimage3D u_acc_albedo;
 layout(binding = 2, r32ui) uniform uimage3D u_acc_normal;
 layout(binding = 3, r32ui) uniform uimage3D u_acc_emission;
 layout(binding = 4, r32ui) uniform uimage3D u_flags;   // 1×1×1; bit 0 set when an area sum wrapped
+#if defined(SIDES)
+layout(binding = 5, r32ui) uniform uimage3D u_acc_albedo_back;
+#endif
 uniform ivec3 u_grid_size;            // grid size (nx, ny, nz)
 
 // Albedo of a voxel surfel: what the surface reflects of the light reaching it, averaged over directions
@@ -50,8 +55,9 @@ vec3 canonical_normal(vec3 n) {
 #define MIN_PIECE_UNITS 64.0
 uint fixed_round(float x) { return uint(x + 0.5); }   // x ≥ 0; monotone, so channel ≤ area channel holds
 
-// Add one surface piece of `area_cells` (area in cell² units) with unit normal `n` to voxel `v`.
-void deposit(ivec3 v, float area_cells, vec3 n, vec3 albedo) {
+// Add one surface piece of `area_cells` (area in cell² units) with unit normal `n` to voxel `v`; `seen`: whether
+// its side along canonical_normal(n) (x) and its other side (y) are uncovered (SIDES only: voxel/raster.glsl).
+void deposit_seen(ivec3 v, float area_cells, vec3 n, vec3 albedo, bvec2 seen) {
     if (any(lessThan(v, ivec3(0))) || any(greaterThanEqual(v, u_grid_size)) || !(area_cells > 0.0)) return;
     // A piece with positive area counts at least MIN_PIECE_UNITS, so occupancy (area > 0) never loses a voxel a
     // surface really crosses and a voxel holding only slivers still gets a mean albedo/normal to 1/64; the bias
@@ -66,9 +72,24 @@ void deposit(ivec3 v, float area_cells, vec3 n, vec3 albedo) {
     imageAtomicAdd(u_acc_area, t + ivec3(1, 0, 0), fixed_round(a * na.y));
     imageAtomicAdd(u_acc_area, t + ivec3(2, 0, 0), fixed_round(a * na.z));
     vec3 alb = a * min(albedo / u_albedo_max, vec3(1.0));
+#if defined(SIDES)
+    if (seen.x) {
+        imageAtomicAdd(u_acc_albedo, t + ivec3(3, 0, 0), a_fix);
+        imageAtomicAdd(u_acc_albedo, t, fixed_round(alb.r));
+        imageAtomicAdd(u_acc_albedo, t + ivec3(1, 0, 0), fixed_round(alb.g));
+        imageAtomicAdd(u_acc_albedo, t + ivec3(2, 0, 0), fixed_round(alb.b));
+    }
+    if (seen.y) {
+        imageAtomicAdd(u_acc_albedo_back, t + ivec3(3, 0, 0), a_fix);
+        imageAtomicAdd(u_acc_albedo_back, t, fixed_round(alb.r));
+        imageAtomicAdd(u_acc_albedo_back, t + ivec3(1, 0, 0), fixed_round(alb.g));
+        imageAtomicAdd(u_acc_albedo_back, t + ivec3(2, 0, 0), fixed_round(alb.b));
+    }
+#else
     imageAtomicAdd(u_acc_albedo, t, fixed_round(alb.r));
     imageAtomicAdd(u_acc_albedo, t + ivec3(1, 0, 0), fixed_round(alb.g));
     imageAtomicAdd(u_acc_albedo, t + ivec3(2, 0, 0), fixed_round(alb.b));
+#endif
     vec3 c = canonical_normal(n) * (0.5 * a);
     imageAtomicAdd(u_acc_normal, t, uint(int(round(c.x))));
     imageAtomicAdd(u_acc_normal, t + ivec3(1, 0, 0), uint(int(round(c.y))));
@@ -79,4 +100,8 @@ void deposit(ivec3 v, float area_cells, vec3 n, vec3 albedo) {
         imageAtomicAdd(u_acc_emission, t + ivec3(1, 0, 0), fixed_round(e.g));
         imageAtomicAdd(u_acc_emission, t + ivec3(2, 0, 0), fixed_round(e.b));
     }
+}
+
+void deposit(ivec3 v, float area_cells, vec3 n, vec3 albedo) {
+    deposit_seen(v, area_cells, n, albedo, bvec2(true));
 }

@@ -13,6 +13,13 @@
 // of "depth + depth derivatives"), and deposit each piece's exact area. Every voxel the surface crosses gets
 // exactly the area of the surface inside it, so areas sum to the triangle's area however coarse the pixels;
 // `u_supersample` only sets how densely textures are sampled (one albedo sample per piece, at its centroid).
+//
+// Covered surfaces (SIDES, after a MODE_FRONT pass): a piece with another one wholly in front of it in the same
+// pixel column and voxel (a rug lying 1 mm above a floor, a poster on a wall) is hidden from that side, so its
+// albedo is left out of that side's mean (voxel/common.glsl deposit_seen): the side sees the rug, the floor's
+// underside the floor. MODE_FRONT keeps, per pixel column, voxel layer and side of the dominant axis, the largest
+// nearest-depth of a piece along that side; a piece is covered on a side when even its farthest point there lies
+// behind that. Pieces of one continuous surface touch along their shared edges, so they never cover each other.
 #if defined(VERTEX_SHADER)
 layout(location = 0) in vec3 in_position;
 layout(location = 1) in vec2 in_uv;
@@ -146,6 +153,25 @@ float poly_area(vec2 p[MAXV], int n, out vec2 center) {
 // Voxel (u, v, depth) in the dominant plane's frame → grid (x, y, z); inverse of to_plane.
 ivec3 from_plane(ivec3 c, int axis) { return axis == 0 ? c.zxy : (axis == 1 ? c.yzx : c); }
 
+#if defined(MODE_FRONT) || defined(SIDES)
+// Per pixel column, dominant axis a and voxel layer k along it: layer offset(a) + 2k the largest nearest-depth
+// (along +a) of a piece, offset(a) + 2k + 1 the largest (1 − farthest depth), in 1/65535 of a cell: larger =
+// further out along that side. The three axes' layers share one image (offsets 0, 2·nx, 2·(nx + ny)).
+layout(binding = 6, r32ui) coherent uniform uimage3D u_front;
+#define FRONT_TOLERANCE 66u   // 1/1000 of a cell: coplanar pieces (duplicates) all count
+
+uint to_front(float f) { return uint(clamp(f, 0.0, 1.0) * 65535.0 + 0.5); }
+
+ivec3 front_texel(int k, int side) {
+    int offset = g_axis == 0 ? 0 : 2 * (g_axis == 1 ? u_grid_size.x : u_grid_size.x + u_grid_size.y);
+    return ivec3(ivec2(gl_FragCoord.xy), offset + 2 * k + side);
+}
+
+uint front_load(ivec3 t) { return imageLoad(u_front, t).r; }
+
+void front_max(ivec3 t, uint d) { imageAtomicMax(u_front, t, d); }
+#endif
+
 void main() {
     vec2 pix = floor(gl_FragCoord.xy);                     // pixel's min corner, in pixels
     ivec2 col = ivec2(pix) / u_supersample_i;             // voxel column in the dominant plane
@@ -182,12 +208,31 @@ void main() {
         if (dmin < float(k)) m = clip(s, m, vec3(g_depth.y, g_depth.z, dc - float(k)));          // depth ≥ k
         if (dmax > float(k + 1)) m = clip(s, m, vec3(-g_depth.y, -g_depth.z, float(k + 1) - dc)); // depth ≤ k+1
         if (m < 3) continue;
+#if defined(MODE_FRONT) || defined(SIDES)
+        float f_lo = 1.0, f_hi = 0.0;  // the piece's depth range within voxel layer k
+        for (int i = 0; i < m; ++i) {
+            float f = dc + g_depth.y * s[i].x + g_depth.z * s[i].y - float(k);
+            f_lo = min(f_lo, f);
+            f_hi = max(f_hi, f);
+        }
+#endif
+#if defined(MODE_FRONT)
+        front_max(front_texel(k, 0), to_front(f_lo));
+        front_max(front_texel(k, 1), to_front(1.0 - f_hi));
+        continue;
+#endif
         vec2 center;
         float area_px = poly_area(s, m, center);
         vec2 r = center + pix - g_p[0];
         float b1 = (r.x * e2.y - r.y * e2.x) * inv_det, b2 = (e1.x * r.y - e1.y * r.x) * inv_det;
         vec2 uv = g_uv[0] + (g_uv[1] - g_uv[0]) * b1 + (g_uv[2] - g_uv[0]) * b2;
-        deposit(from_plane(ivec3(col, k), g_axis), area_px * g_area_per_px, g_normal, voxel_albedo(uv));
+        bvec2 seen = bvec2(true);
+#if defined(SIDES)
+        // The canonical normal points along +axis of the dominant axis: side 0 is the voxel's front.
+        seen = bvec2(to_front(f_hi) + FRONT_TOLERANCE >= front_load(front_texel(k, 0)),
+                     to_front(1.0 - f_lo) + FRONT_TOLERANCE >= front_load(front_texel(k, 1)));
+#endif
+        deposit_seen(from_plane(ivec3(col, k), g_axis), area_px * g_area_per_px, g_normal, voxel_albedo(uv), seen);
     }
 }
 #endif

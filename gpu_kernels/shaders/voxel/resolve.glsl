@@ -5,6 +5,8 @@
 //   albedo   rgb = Σ A·albedo / Σ A, a = opacity = min(1, max projected area / cell²)
 //   normal   xyz = Σ A·n̂ / Σ A with n̂ sign-canonicalised (not renormalised: |mean| < 1 says normals disagree)
 //   emission rgb = Σ A·emission / Σ A
+//   with SIDES, albedo rgb is the mean over the pieces seen from the front side only (voxel/common.glsl) and a fifth
+//   volume, albedo_back, the back side's (rgb; a = the same opacity)
 // Pure integer→float arithmetic per voxel: deterministic.
 layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
 uniform ivec3 u_grid_size;
@@ -14,6 +16,9 @@ layout(binding = 0, r32ui) uniform writeonly uimage3D u_acc0;
 layout(binding = 1, r32ui) uniform writeonly uimage3D u_acc1;
 layout(binding = 2, r32ui) uniform writeonly uimage3D u_acc2;
 layout(binding = 3, r32ui) uniform writeonly uimage3D u_acc3;
+#if defined(SIDES)
+layout(binding = 4, r32ui) uniform writeonly uimage3D u_acc4;
+#endif
 void main() {
     ivec3 v = ivec3(gl_GlobalInvocationID);
     if (any(greaterThanEqual(v, u_grid_size))) return;
@@ -23,6 +28,9 @@ void main() {
         imageStore(u_acc1, t, uvec4(0u));
         imageStore(u_acc2, t, uvec4(0u));
         imageStore(u_acc3, t, uvec4(0u));
+#if defined(SIDES)
+        imageStore(u_acc4, t, uvec4(0u));
+#endif
     }
 }
 #endif
@@ -40,6 +48,15 @@ layout(binding = 0, rgba32f) uniform writeonly image3D u_area;
 layout(binding = 1, rgba32f) uniform writeonly image3D u_albedo;
 layout(binding = 2, rgba32f) uniform writeonly image3D u_normal;
 layout(binding = 3, rgba32f) uniform writeonly image3D u_emission;
+#if defined(SIDES)
+uniform usampler3D u_acc_albedo_back;
+layout(binding = 4, rgba32f) uniform writeonly image3D u_albedo_back;
+
+// Mean albedo over the area a side sees (.w); 0 where it sees none.
+vec3 side_albedo(uvec4 acc) {
+    return acc.w > 0u ? vec3(acc.rgb) * (u_albedo_max / float(acc.w)) : vec3(0.0);
+}
+#endif
 
 uvec4 fetch(usampler3D s, ivec3 v) {
     ivec3 t = ivec3(4 * v.x, v.y, v.z);
@@ -50,7 +67,7 @@ uvec4 fetch(usampler3D s, ivec3 v) {
 void main() {
     ivec3 v = ivec3(gl_GlobalInvocationID);
     if (any(greaterThanEqual(v, u_grid_size))) return;
-    vec4 area_m2 = vec4(0.0), albedo = vec4(0.0), normal = vec4(0.0), emission = vec4(0.0);
+    vec4 area_m2 = vec4(0.0), albedo = vec4(0.0), normal = vec4(0.0), emission = vec4(0.0), back = vec4(0.0);
     uint total = texelFetch(u_acc_area, ivec3(4 * v.x + 3, v.y, v.z), 0).r;
     if (total > 0u) {   // most voxels are empty: one fetch decides
         uvec4 area = fetch(u_acc_area, v);
@@ -60,10 +77,17 @@ void main() {
         albedo.a = min(1.0, max(max(area_m2.x, area_m2.y), area_m2.z) / u_cell_area);
         normal.xyz = vec3(ivec3(fetch(u_acc_normal, v).xyz)) * (2.0 * inv);
         emission.rgb = vec3(fetch(u_acc_emission, v).rgb) * (inv * u_emission_max);
+#if defined(SIDES)
+        albedo.rgb = side_albedo(fetch(u_acc_albedo, v));
+        back = vec4(side_albedo(fetch(u_acc_albedo_back, v)), albedo.a);
+#endif
     }
     imageStore(u_area, v, area_m2);
     imageStore(u_albedo, v, albedo);
     imageStore(u_normal, v, normal);
     imageStore(u_emission, v, emission);
+#if defined(SIDES)
+    imageStore(u_albedo_back, v, back);
+#endif
 }
 #endif
