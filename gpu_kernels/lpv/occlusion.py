@@ -33,10 +33,11 @@ class GeometryVolume:
     # floor from), from the materials they were voxelised with
     surface_albedo: np.ndarray | None = None
     albedo_back: object = None  # the back side's albedo texture (None: `albedo` serves both sides)
+    front: object = None  # the voxelisation's front-most image, kept for material edits (up to KEEP_FRONT_BYTES)
 
     def release(self):
         for t in (self.blocking, self.area, self.normal, self.albedo, self.coverage, self.layers, self.surfaces,
-                  self.albedo_back):
+                  self.albedo_back, self.front):
             if t is not None:
                 t.release()
 
@@ -65,6 +66,9 @@ def face_blocking(area: np.ndarray, grid: Grid) -> np.ndarray:
     return out.astype(np.float32)
 
 
+# The voxelisation's front-most image (voxel/voxelize.py sides=True) is kept with a cascade's geometry volume up to
+# this size (28 MB at the default 32³), so a material edit re-voxelises the albedo without rasterising it again.
+KEEP_FRONT_BYTES = 64 * 2 ** 20
 PLANAR = 0.9  # a cell whose surfaces' normals share one plane this closely (λ_max / trace) is one oblique plane
 
 
@@ -132,12 +136,13 @@ def geometry_volumes(ctx, programs, scene: Scene, geometry, textures, grids: lis
     """
     import moderngl
 
-    from ..voxel.voxelize import voxelize
+    from ..voxel.voxelize import front_bytes, voxelize
 
     out = []
     for grid in grids:
         fine = Grid(tuple(np.asarray(grid.origin) - grid.cell / 2), grid.cell / 2, tuple(2 * n + 2 for n in grid.size))
-        vox = voxelize(ctx, programs, scene, geometry, textures, fine, sides=True)
+        keep = front_bytes(fine, 2) <= KEEP_FRONT_BYTES
+        vox = voxelize(ctx, programs, scene, geometry, textures, fine, sides=True, keep_front=keep)
         arrays = vox.read()
         area = arrays["area"]
         blocking = face_blocking(area, grid)
@@ -158,7 +163,8 @@ def geometry_volumes(ctx, programs, scene: Scene, geometry, textures, grids: lis
         normals = arrays["normal"][z, y, x, :3]
         out.append(GeometryVolume(tex, fine, vox.area, vox.normal, vox.albedo, *crossings, surfaces, len(cells),
                                   cells[:, :3], normals, layer_area(area[z, y, x, 3], normals, fine.cell),
-                                  side_albedo(arrays, cells[:, :3]), albedo_back=vox.albedo_back))
+                                  side_albedo(arrays, cells[:, :3]), albedo_back=vox.albedo_back,
+                                  front=vox.front))
     return out
 
 
@@ -177,8 +183,8 @@ def surface_albedo(ctx, programs, scene: Scene, geometry, textures, gv: Geometry
     lpv/transfer.py)."""
     from ..voxel.voxelize import voxelize
 
-    vox = voxelize(ctx, programs, scene, geometry, textures, gv.fine, sides=True)
-    arrays = vox.read()
+    vox = voxelize(ctx, programs, scene, geometry, textures, gv.fine, sides=True, front=gv.front)
+    arrays = vox.read(("albedo", "albedo_back"))
     vox.release()
     return side_albedo(arrays, gv.cells)
 

@@ -61,6 +61,7 @@ class VoxelVolumes:
     scale_bits: int          # fixed-point bits actually used
     reruns: int = 0          # re-runs after a fixed-point overflow (0 normally)
     albedo_back: object = None
+    front: object = None     # sides=True, keep_front=True: the front-most image, the caller's to release or reuse
 
     def textures(self) -> dict:
         out = {name: getattr(self, name) for name in VOLUME_NAMES}
@@ -68,11 +69,12 @@ class VoxelVolumes:
             out["albedo_back"] = self.albedo_back
         return out
 
-    def read(self) -> dict:
-        """{name: (nz, ny, nx, 4) float32} — call on the GL thread (e.g. inside ``Engine().worker.call``)."""
+    def read(self, names=None) -> dict:
+        """{name: (nz, ny, nx, 4) float32} of every volume, or of those in `names` that exist — call on the GL
+        thread (e.g. inside ``Engine().worker.call``)."""
         nx, ny, nz = self.grid.size
         return {name: np.frombuffer(tex.read(), np.float32).reshape(nz, ny, nx, 4).copy()
-                for name, tex in self.textures().items()}
+                for name, tex in self.textures().items() if names is None or name in names}
 
     def occupancy(self) -> np.ndarray:
         """(nz, ny, nx) bool: voxels with surface area > 0 (GL thread)."""
@@ -85,7 +87,8 @@ class VoxelVolumes:
 
 
 def voxelize(ctx, programs, scene: Scene, geometry, textures, grid: Grid, mode: str = "raster",
-             supersample: int = 2, scale_bits: int = DEFAULT_SCALE_BITS, sides: bool = False) -> VoxelVolumes:
+             supersample: int = 2, scale_bits: int = DEFAULT_SCALE_BITS, sides: bool = False, front=None,
+             keep_front: bool = False) -> VoxelVolumes:
     """Voxelise the scene's surfaces into `grid` (GL thread); returns new textures the caller releases.
 
     `geometry`: direct/geometry.GeometryBuffers of `scene` (raster draws its VBO; tessellation uploads its own patch
@@ -93,7 +96,9 @@ def voxelize(ctx, programs, scene: Scene, geometry, textures, grid: Grid, mode: 
     direct/geometry.upload_textures. `supersample`: raster — pixels per voxel edge, i.e. texture samples per voxel face
     (areas are exact at any value); tessellation — sub-triangles per voxel edge. `scale_bits`: fixed-point
     fraction bits (1 unit = 2^-bits cell²); lowered automatically, and reported, if a voxel's sum would wrap.
-    `sides`: keep the albedo per side, covered surfaces left out of the side they are hidden from (raster only).
+    `sides`: keep the albedo per side, covered surfaces left out of the side they are hidden from (raster only);
+    the front-most image this needs depends on the geometry alone: `keep_front` hands it over in the result's
+    `front`, and `front` takes one back (same geometry, grid and supersample) instead of rasterising it again.
     """
     import moderngl
 
@@ -109,7 +114,9 @@ def voxelize(ctx, programs, scene: Scene, geometry, textures, grid: Grid, mode: 
     for t in accs + [flags]:
         t.filter = (moderngl.NEAREST, moderngl.NEAREST)
     patches = _tessellation_buffers(ctx, scene, grid, supersample) if mode == "tessellation" else None
-    fronts = _front_most(ctx, programs, scene, geometry, textures, grid, supersample) if sides else []
+    own_front = sides and front is None
+    fronts = [] if not sides else [front] if front is not None else \
+        _front_most(ctx, programs, scene, geometry, textures, grid, supersample)
     try:
         reruns = 0
         while True:
@@ -133,12 +140,13 @@ def voxelize(ctx, programs, scene: Scene, geometry, textures, grid: Grid, mode: 
             reruns += 1
         volumes = _resolve(ctx, programs, accs, grid, scale_bits, albedo_max, emission_max)
     finally:
-        for t in accs + [flags] + fronts:
+        for t in accs + [flags] + (fronts if own_front and not keep_front else []):
             t.release()
         if patches is not None:
             patches[0].release()
     return VoxelVolumes(grid, *volumes[:4], mode=mode, supersample=supersample, scale_bits=scale_bits,
-                        reruns=reruns, albedo_back=volumes[4] if sides else None)
+                        reruns=reruns, albedo_back=volumes[4] if sides else None,
+                        front=fronts[0] if own_front and keep_front else None)
 
 
 def front_bytes(grid: Grid, supersample: int) -> int:

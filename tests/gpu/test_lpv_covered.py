@@ -56,3 +56,23 @@ def test_a_rug_on_a_floor_bounces_its_own_colour(engine, bounces):
     print(f"bounces {bounces}: wall green/red {ratio:.4f} (rug {RUG[1] / RUG[0]:.4f}) over {on_wall.sum()} pixels")
     assert on_wall.sum() > 200
     assert ratio < 0.145
+
+
+def test_a_material_edit_reuses_the_front_most_image_and_gives_a_cold_render(engine):
+    """A material edit re-voxelises only the albedo, reading the front-most image kept with the geometry volume
+    (lpv/occlusion.KEEP_FRONT_BYTES) instead of rasterising it again: the recoloured rug's bounce must be exactly
+    what a fresh engine renders (the pipeline is deterministic: fixed-point sums), and blue now."""
+    settings = RenderSettings("lpv", 80, 60, lpv=LpvSettings(resolution=32, bounces=3))
+    engine.render(_spot_over_a_rug(), settings)
+    blue = _spot_over_a_rug()
+    blue.materials[1] = Material("rug", (0.05, 0.2, 0.6))
+    warm = engine.render(blue, settings)
+    assert "geometry_volume" in warm.skipped and "lpv_albedo" not in warm.skipped
+    cold_engine = Engine()
+    try:
+        cold = cold_engine.render(blue, settings)
+    finally:
+        cold_engine.shutdown()
+    np.testing.assert_array_equal(warm.passes["Diffuse Indirect"], cold.passes["Diffuse Indirect"])
+    di = warm.passes["Diffuse Indirect"][warm.passes["Depth"][..., 0] < 1e9]
+    assert di[:, 2].sum() > 2.0 * di[:, 0].sum()  # the blue rug's light
