@@ -30,6 +30,9 @@ from .state import LpvGridState, cascade_grids
 
 # Outputs kept per pass (gl/pass_cache.py): the geometry's passes for two settings (the live viewport's draft and
 # final stages use two grids; each would otherwise rebuild its transfer on every edit).
+# An orthographic RSM view (a sun's) needs no finer texels than this many per LPV cell: two per surface voxel
+# (half a cell), into which its texels' flux is binned (lpv/rsm.view_resolution).
+RSM_TEXELS_PER_CELL = 2
 KEEP = {name: 2 for name in ("geometry_volume", "lpv_albedo", "lpv_transfer", "lpv_transfer_albedo")}
 
 
@@ -38,9 +41,10 @@ def run(frame) -> MethodOutput:
     ctx, programs, cache, scene, s = frame.ctx, frame.programs, frame.cache, frame.scene, frame.settings.lpv
     grids = cascade_grids(scene, s)
     k_grids = tuple(g.key() for g in grids)
-    k_rsm = (frame.keys["shadow"], s.rsm_resolution)
+    texel = min(g.cell for g in grids) / RSM_TEXELS_PER_CELL
+    k_rsm = (frame.keys["shadow"], s.rsm_resolution, texel)
     maps = cache.run("rsm", k_rsm, lambda: rsm.render_rsm(ctx, programs, scene, frame.geometry, frame.textures,
-                                                           frame.shadows, s.rsm_resolution))
+                                                           frame.shadows, s.rsm_resolution, texel))
     budget = transfer_budget(scene, grids, s)
     if budget:
         return _transfer(frame, grids, k_grids, maps, k_rsm, budget)

@@ -62,29 +62,35 @@ def flux_bound(buffers: lb.LightBuffers) -> float:
     return max(total, 1e-12)
 
 
-def view_resolution(resolution: int, ortho: bool, samples: int) -> int:
+def view_resolution(resolution: int, ortho: bool, samples: int, width: float = 0.0, texel: float = 0.0) -> int:
     """Texels per side of one RSM view: `resolution` (a sun's map twice that). A light sampled from several points
     (an area light's samples, each its own view of the same surfaces) splits its flux between them, and each of
     its texels' flux loops over every sample (lpv/inject.glsl); so each view gets 1/samples of the side, which
-    keeps the light's work about one view's worth — the views together still cover its surfaces densely. A
-    multiple of 16 (lpv/inject.glsl's blocks never straddle views)."""
+    keeps the light's work about one view's worth — the views together still cover its surfaces densely. An
+    orthographic view `width` metres across needs texels no finer than `texel` (> 0): its texels' flux is binned
+    into surface voxels (lpv/clusters.bin_flux), and a texel much smaller than one only costs time (a sun's 256²
+    over a 25 m courtyard was 4 times what the voxels resolve, and most of a light edit there). A multiple of 16
+    (lpv/inject.glsl's blocks never straddle views)."""
     side = resolution * (2 if ortho else 1)
+    if ortho and width > 0.0 and texel > 0.0:
+        side = min(side, max(16, 16 * math.ceil(width / texel / 16)))
     if samples > 1:
         side = max(16, 16 * round(side / samples / 16))
     return side
 
 
-def render_rsm(ctx, programs, scene: Scene, geometry, textures, shadows, resolution: int) -> Rsm:
+def render_rsm(ctx, programs, scene: Scene, geometry, textures, shadows, resolution: int, texel: float = 0.0) -> Rsm:
     """Render every shadow view of every light once more as an RSM (position, normal, albedo) into an atlas —
     except the views of samples whose light is trapped inside a closed emitter (common/emitters.py): their VPLs
-    would light only its inside, and the volume would let that light out."""
+    would light only its inside, and the volume would let that light out. `texel` (m, > 0): the finest texel an
+    orthographic view needs (view_resolution)."""
     import moderngl
 
     buffers = shadows.buffers
     kept = [i for i, v in enumerate(buffers.views) if not v.emit_share < 0]
     views = [buffers.views[i] for i in kept]
     view_lights = [buffers.view_lights[i] for i in kept]
-    res = [view_resolution(resolution, v.ortho, int(buffers.lights[light]["params"][2]))
+    res = [view_resolution(resolution, v.ortho, int(buffers.lights[light]["params"][2]), 2 * v.half_extent, texel)
            for v, light in zip(views, view_lights)]
     tiles, size, scale = lb.allocate_atlas(res, max_height=ctx.info.get("GL_MAX_TEXTURE_SIZE", 16384))
     targets = [ctx.texture(size, 4, dtype="f4") for _ in range(3)]

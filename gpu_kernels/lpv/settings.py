@@ -9,7 +9,7 @@ from dataclasses import dataclass
 class LpvSettings:
     resolution: int = 32  # cells along the longest axis of the (finest) grid
     cascades: int = 1  # nested grids, each twice the extent of the last
-    rsm_resolution: int = 128  # texels per side of each RSM view (sun: twice that)
+    rsm_resolution: int = 128  # texels per side of each RSM view (sun: twice that, at most 4 texels per LPV cell)
     rsm_downsample: int = 1  # propagate: inject one VPL per k×k RSM texels, intensity-aware (Kaplanyan 2009); 1, 2, 4
     max_iterations: int = 64
     epsilon: float = 1e-3  # stop when one step moved less than this fraction of the injected flux
