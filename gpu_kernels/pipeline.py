@@ -10,7 +10,8 @@ Passes and their inputs (a pass re-runs only when one of its inputs changed — 
       shadow_depth← geometry, the shadow views (their depth atlas: a light's power or the world's colour
                     moves no view, so it is kept)
     gbuffer       ← geometry, materials, camera, resolution
-    direct_light  ← gbuffer, shadow_maps
+    sky_visibility← gbuffer, the shadow views (the sky light's visible shares: a world colour edit keeps them)
+    direct_light  ← gbuffer, shadow_maps, sky_visibility
     <method>      ← the above (lpv/passes.py, vct/passes.py: the indirect light)
     compose       ← everything above, world      (CPU: passes as numpy, Combined)
 
@@ -150,8 +151,7 @@ class Pipeline:
         start = time.perf_counter()
         self.cache.begin_frame()
         frame = self._direct_passes(scene, settings)
-        direct_tex = self.cache.run("direct_light", frame.keys["direct"], lambda: lighting.render_direct_light(
-            self.ctx, self.programs, frame.gbuffer, frame.shadows, frame.textures.lut))
+        direct_tex = self._direct_light(frame, frame.textures.lut)
         method = METHOD_PASSES.get(settings.method)
         out = method(frame) if method else None
 
@@ -213,9 +213,17 @@ class Pipeline:
         frame the method's passes read."""
         check_method(settings)  # no camera needed
         frame = self._direct_passes(scene, settings, samples)
-        tex = self.cache.run("direct_light", frame.keys["direct"], lambda: lighting.render_direct_light(
-            self.ctx, self.programs, frame.gbuffer, frame.shadows))
+        tex = self._direct_light(frame, None)
         return read_texture(tex["diffuse"], 3)[::-1], frame
+
+    def _direct_light(self, frame, material_lut) -> dict:
+        """The direct_light pass, and before it the sky light's visibility, kept apart (sky_visibility): it depends
+        on the G-buffer and the shadow maps, not on any light's colour, so a world or light colour edit skips it."""
+        sky = self.cache.run("sky_visibility", (frame.keys["gbuffer"], frame.shadows.views_key),
+                             lambda: lighting.render_sky_visibility(self.ctx, self.programs, frame.gbuffer,
+                                                                    frame.shadows, material_lut))
+        return self.cache.run("direct_light", frame.keys["direct"], lambda: lighting.render_direct_light(
+            self.ctx, self.programs, frame.gbuffer, frame.shadows, material_lut, sky))
 
     @staticmethod
     def _method_output(frame):

@@ -23,6 +23,7 @@ class ShadowAtlas:
     warnings: list
     buffers: lb.LightBuffers  # the CPU-side records (RSMs reuse the views)
     owns_depth: bool = True  # False where the depth atlas is cached apart (render_shadow_atlas's depth_pass)
+    views_key: str = ""  # views_key: what the maps and records are besides the lights' colours
 
     def release(self):
         for obj in (self.light_ssbo, self.view_ssbo, self.polygon_ssbo) + ((self.depth,) if self.owns_depth else ()):
@@ -46,10 +47,22 @@ def render_shadow_atlas(ctx, programs, scene: Scene, geometry: GeometryBuffers,
     def render():
         return render_depth(ctx, programs, geometry, buffers.views, tiles, size)
 
-    depth = render() if depth_pass is None else depth_pass(depth_key(buffers.views, tiles, size), render)
+    key = depth_key(buffers.views, tiles, size)
+    depth = render() if depth_pass is None else depth_pass(key, render)
     views = lb.pack_views(buffers.views, tiles, size, settings.pcf_radius, buffers.view_lights)
     return ShadowAtlas(depth, size, ssbo(ctx, buffers.lights), ssbo(ctx, views), ssbo(ctx, buffers.polygon_vertices),
-                       len(buffers.lights), len(buffers.views), warnings, buffers, owns_depth=depth_pass is None)
+                       len(buffers.lights), len(buffers.views), warnings, buffers, owns_depth=depth_pass is None,
+                       views_key=views_key(buffers, key, views))
+
+
+def views_key(buffers: lb.LightBuffers, depth: str, packed) -> str:
+    """What the shadow maps and every light record are besides the lights' colours (colour × power or strength):
+    the depth atlas's key, the packed views, the records with their colours zeroed, the polygons. Whatever depends
+    on the lights' shapes and places but scales with their colours (the sky's visibility, the RSMs) is keyed by
+    it, so a colour, power or world edit leaves it."""
+    records = buffers.lights.copy()
+    records["color_type"][:, :3] = 0.0
+    return hash_parts(depth, packed, records, buffers.polygon_vertices)
 
 
 def depth_key(views: list, tiles: list, size: tuple) -> str:

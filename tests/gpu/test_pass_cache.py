@@ -110,8 +110,8 @@ def test_downstream_keys_rerun_transitively():
 SUN_STRENGTH = 3.0
 FLOOR_ALBEDO = (0.5, 0.4, 0.3)
 BOX = (np.array([-0.5, -0.5, 0.0]), np.array([0.5, 0.5, 1.0]))
-ALL_PASSES = {"geometry", "textures", "emitter_shells", "shadow_depth", "shadow_maps", "gbuffer", "direct_light",
-              "compose"}
+ALL_PASSES = {"geometry", "textures", "emitter_shells", "shadow_depth", "shadow_maps", "gbuffer", "sky_visibility",
+              "direct_light", "compose"}
 
 
 def _quad(a, b, c, d, normal):
@@ -273,16 +273,18 @@ def test_pipeline_reruns_only_what_changed(engine, settings):
     assert set(fifth.skipped) == {"geometry", "textures", "emitter_shells", "gbuffer"}
 
     # Another world colour, and then a brighter sun: the lights' records change, no shadow view does, so the
-    # depth atlas (the sky's 384 maps among them) is kept — and the image is what a cold render gives.
+    # depth atlas (the sky's 384 maps among them) and the sky's visible shares are kept — and the image is what a
+    # cold render gives.
+    kept = {"geometry", "textures", "emitter_shells", "shadow_depth", "gbuffer", "sky_visibility"}
     recoloured = make_scene(sun(-50.0), cam2)
     recoloured.world.color = (0.3, 0.2, 0.1)
     sixth = engine.render(recoloured, settings)
-    assert set(sixth.skipped) == {"geometry", "textures", "emitter_shells", "shadow_depth", "gbuffer"}
+    assert set(sixth.skipped) == kept
     brighter = make_scene(sun(-50.0), cam2)
     brighter.world.color = (0.3, 0.2, 0.1)
     brighter.lights[0].power *= 2.0
     seventh = engine.render(brighter, settings)
-    assert set(seventh.skipped) == {"geometry", "textures", "emitter_shells", "shadow_depth", "gbuffer"}
+    assert set(seventh.skipped) == kept
     from bounce_gi.gpu_kernels.engine import Engine
 
     cold_engine = Engine()

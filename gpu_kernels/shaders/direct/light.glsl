@@ -24,6 +24,13 @@ uniform vec3 u_forward;
 uniform bool u_ortho;
 uniform int u_light_count;
 uniform ivec2 u_size;
+// The sky light's shares come from the sky_visibility pass (MODE_SKY, direct/lighting.py) where u_sky_cached:
+// they depend on the G-buffer and the sky's shadow maps only, so a world colour edit reads them back.
+uniform bool u_sky_cached;
+uniform sampler2D u_sky_shares;
+#if defined(MODE_SKY)
+layout(rg32f, binding = 2) uniform writeonly image2D u_sky_out;
+#endif
 
 // The sky light's visible shares at p, from one shadow test per direction (direct/eval.glsl sky_direction): x of
 // the cosine weight (irradiance), y (when `lobe_seen`) of the glossy lobe's (direct/ggx.glsl sky_lobe_weight). The
@@ -52,8 +59,12 @@ void main() {
     if (any(greaterThanEqual(px, u_size))) return;
     vec4 pos = texelFetch(u_position, px, 0);
     if (pos.w < 0.5) {
+#if defined(MODE_SKY)
+        imageStore(u_sky_out, px, vec4(0.0));
+#else
         imageStore(u_diffuse_direct, px, vec4(0.0));
         imageStore(u_glossy_direct, px, vec4(0.0));
+#endif
         return;
     }
     vec3 n = normalize(texelFetch(u_normal, px, 0).xyz);
@@ -63,13 +74,21 @@ void main() {
     vec4 spec = texelFetch(u_specular, px, 0);
     vec3 v = u_ortho ? -u_forward : normalize(u_eye - pos.xyz);
     GlossyLobe lobe = GlossyLobe(glossy.w * glossy.w, int(spec.w + 0.5), dot(n, v), spec.rgb);
+    bool lobe_seen = has_glossy && lobe.mu > 0.0;
+#if defined(MODE_SKY)
+    vec2 sky = vec2(0.0);
+    for (int i = 0; i < u_light_count; ++i)
+        if (int(lights[i].color_type.w) == LIGHT_SKY) sky = sky_shares(lights[i], pos.xyz, n, geo_n, lobe, v, lobe_seen);
+    imageStore(u_sky_out, px, vec4(sky, 0.0, 0.0));
+    return;
+#endif
     vec3 irradiance = vec3(0.0), reflected = vec3(0.0), world = vec3(0.0);
     for (int i = 0; i < u_light_count; ++i) {
         if (int(lights[i].color_type.w) == LIGHT_SKY) {
             // The world: irradiance π·L and, for any roughness, its reflection L (Glossy Color divided out; Cycles
             // counts the world a mirror shows as direct light too), each times its share of the sky that is seen.
-            bool lobe_seen = has_glossy && lobe.mu > 0.0;
-            vec2 shares = sky_shares(lights[i], pos.xyz, n, geo_n, lobe, v, lobe_seen);
+            vec2 shares = u_sky_cached ? texelFetch(u_sky_shares, px, 0).xy
+                                       : sky_shares(lights[i], pos.xyz, n, geo_n, lobe, v, lobe_seen);
             irradiance += light_unshadowed(lights[i], pos.xyz, n) * shares.x;
             if (lobe_seen) world += lights[i].color_type.rgb * shares.y;
             continue;
