@@ -111,14 +111,16 @@ def _fitted(ctx, records: np.ndarray, size: float, block: int, budget: int) -> V
     return VplList(ctx.buffer(payload), len(records), flux, block)
 
 
-def rsm_records(ctx, programs, rsm, shadows, grid: Grid, budget: int, limit: int | None = None
-                ) -> tuple[np.ndarray, int]:
+def rsm_records(ctx, programs, rsm, shadows, grid: Grid, budget: int, limit: int | None = None,
+                unit_color: bool = False) -> tuple[np.ndarray, int]:
     """The RSM as VPL records (VPL_DTYPE) and k: k×k texel blocks (intensity-aware, lpv/inject.glsl MODE_LIST), k the
     smallest power of two whose blocks number at most `limit` (default a few times `budget`: much of an atlas is
     empty, a sun's map covers the whole grid, a spot's cone a disc). A block spanning two surfaces gives two VPLs;
-    the grid's cell sets the plane tolerance."""
+    the grid's cell sets the plane tolerance. Each record's flux.w is its light's index; with `unit_color` its flux
+    is per unit of that light's colour (the flux a colour of 1 would give)."""
     prog = programs.compute("lpv/inject.glsl", {"MODE_LIST": 1})
     bind_grid(prog, grid)
+    set_uniform(prog, "u_unit_color", bool(unit_color))
 
     def cluster(k):
         blocks = rsm_uniforms(prog, rsm, shadows, k)

@@ -6,13 +6,13 @@ from __future__ import annotations
 
 from ..gl.bind import bind_grid, dispatch, set_uniform
 from .gather import rsm_uniforms, vpl_list
-from .rsm import Rsm
+from .rsm import Rsm, flux_bound
 from .state import FIXED_RANGE, LpvGridState, resolve
 
 
 def inject(ctx, programs, rsm: Rsm, shadows, state: LpvGridState, downsample: int = 1) -> float:
     """RSM texels → fixed-point SH sums → state.injected. Returns the injected flux (W, sum of RGB)."""
-    scale = FIXED_RANGE / max(rsm.flux_bound, 1e-30)
+    scale = FIXED_RANGE / max(flux_bound(shadows.buffers), 1e-30)
     state.accum_ints.clear()
     prog = programs.compute("lpv/inject.glsl")
     blocks = rsm_uniforms(prog, rsm, shadows, downsample)

@@ -42,7 +42,8 @@ def run(frame) -> MethodOutput:
     grids = cascade_grids(scene, s)
     k_grids = tuple(g.key() for g in grids)
     texel = min(g.cell for g in grids) / RSM_TEXELS_PER_CELL
-    k_rsm = (frame.keys["shadow"], s.rsm_resolution, texel)
+    # The RSMs hold positions, normals and albedo: they follow the lights' views, not their colours.
+    k_rsm = (frame.keys["geometry"], frame.keys["materials"], frame.shadows.views_key, s.rsm_resolution, texel)
     maps = cache.run("rsm", k_rsm, lambda: rsm.render_rsm(ctx, programs, scene, frame.geometry, frame.textures,
                                                            frame.shadows, s.rsm_resolution, texel))
     budget = transfer_budget(scene, grids, s)
@@ -52,7 +53,7 @@ def run(frame) -> MethodOutput:
     gvs = cache.run("geometry_volume", k_gv, lambda: occlusion.geometry_volumes(
         ctx, programs, scene, frame.geometry, frame.textures, grids) if s.occlusion else [None] * len(grids))
     gather_vpls = s.gather_vpls if s.gathers else 0
-    k_inject = (k_rsm, k_grids, s.rsm_downsample, gather_vpls)
+    k_inject = (k_rsm, frame.keys["shadow"], k_grids, s.rsm_downsample, gather_vpls)  # the lights' colours too
     states = cache.run("lpv_inject", k_inject, lambda: inject.inject_all(
         ctx, programs, maps, frame.shadows, grids, s.rsm_downsample, gather_vpls))
     k_prop = (k_inject, k_gv, repr(s))
@@ -124,12 +125,18 @@ def _transfer(frame, grids, k_grids, maps, k_rsm, budget) -> MethodOutput:
     """The cached transport's passes (lpv/transfer.py); see the module docstring for what each reads."""
     ctx, programs, cache, scene, s = frame.ctx, frame.programs, frame.cache, frame.scene, frame.settings.lpv
     gvs, transfers, _, reflection, keys = _transfer_geometry(frame, grids, k_grids, budget)
+    # Each light's first bounce per unit of its colour, binned once (colour-free key: the RSMs' and the clusters'):
+    # a colour, power or world edit only rescales them in the solve.
     k_src = (k_rsm, keys["transfer"])
-    sources = cache.run("lpv_inject", k_src, lambda: [clusters.bin_flux(t.clusters, gather.rsm_records(
-        ctx, programs, maps, frame.shadows, grid, budget, clusters.TEXEL_RECORDS)[0], t.cells, t.normals)
-        for t, grid in zip(transfers, grids)])
-    k_prop = (k_src, keys["albedo_transfer"], keys["gv"], s.max_iterations, s.clamp_negative, s.bounces, s.epsilon)
-    solved = cache.run("lpv_propagate", k_prop, lambda: _solve(ctx, gvs, grids, transfers, reflection, sources, s))
+    lights = len(frame.shadows.buffers.lights)
+    units = cache.run("lpv_inject", k_src, lambda: [clusters.bin_flux(t.clusters, gather.rsm_records(
+        ctx, programs, maps, frame.shadows, grid, budget, clusters.TEXEL_RECORDS, unit_color=True)[0], t.cells,
+        t.normals, groups=lights) for t, grid in zip(transfers, grids)])
+    colours = frame.shadows.buffers.lights["color_type"][:, :3].astype(np.float64)  # (lights, 3)
+    k_prop = (k_src, frame.keys["shadow"], keys["albedo_transfer"], keys["gv"], s.max_iterations, s.clamp_negative,
+              s.bounces, s.epsilon)
+    solved = cache.run("lpv_propagate", k_prop, lambda: _solve(ctx, gvs, grids, transfers, reflection, [
+        (np.einsum("gck,gk->ck", first, colours), float((lost * colours).sum())) for first, lost in units], s))
     k_light = (frame.keys["gbuffer"], k_prop)
     indirect = cache.run("lpv_lighting", k_light,
                          lambda: lighting.lighting(ctx, programs, frame.gbuffer, solved["surfaces"], gvs, s))

@@ -22,7 +22,6 @@ class Rsm:
     views_ssbo: object
     size: tuple
     resolution: int
-    flux_bound: float
     vao: object = None
     fbo: object = None
     depth: object = None
@@ -123,4 +122,4 @@ def render_rsm(ctx, programs, scene: Scene, geometry, textures, shadows, resolut
         records[i]["origin"] = (*view.origin, 1.0 if view.ortho else 0.0)
         records[i]["axis"] = (*-back, float(w))  # w: texels per side of this view
         records[i]["right"] = (*right, view.own_extent)
-    return Rsm(*targets, ssbo(ctx, records), size, resolution // scale, flux_bound(buffers), vao, fbo, depth)
+    return Rsm(*targets, ssbo(ctx, records), size, resolution // scale, vao, fbo, depth)

@@ -32,6 +32,9 @@ layout(std430, binding = 3) readonly buffer RsmViewBuffer { RsmView rsm_views[];
 layout(std430, binding = 6) writeonly buffer VplList { Vpl vpls[]; };
 uniform int u_blocks_x;           // blocks per atlas row: the list slot of a block
 #endif
+// The flux per unit of each light's colour (colour × power or strength = 1), its light's index in the record's
+// flux.w (MODE_LIST): the LPV's cached transport bins each light's records once and scales them by its colour.
+uniform bool u_unit_color;
 
 // Solid angle of one texel of a perspective view with tan(half fov) m at tangent-plane point (x, y):
 // (2m/res)² / (1 + x² + y²)^(3/2).
@@ -63,7 +66,7 @@ float cube_share(RsmView v, vec3 p) {
 vec3 vpl_flux(RsmView v, vec3 p, vec3 n, vec3 albedo) {
     GpuLight L = lights[int(v.params.z)];
     int type = int(L.color_type.w);
-    vec3 color = L.color_type.rgb;
+    vec3 color = u_unit_color ? vec3(1.0) : L.color_type.rgb;
     if (type == LIGHT_SUN) {
         // E·A = S·cosθ · t²/cosθ: the sun's flux through one texel of the orthographic map.
         float cosine = dot(n, -L.direction.xyz);
@@ -117,6 +120,7 @@ void main() {
     float weight[2] = float[2](0.0, 0.0);
     bool has_plane = false;
     vec3 plane_p = vec3(0.0), plane_n = vec3(0.0);
+    float light = 0.0;  // the block's light (blocks never straddle views)
     for (int j = 0; j < u_downsample; ++j)
         for (int i = 0; i < u_downsample; ++i) {
             ivec2 px = block * u_downsample + ivec2(i, j);
@@ -127,6 +131,7 @@ void main() {
                 has_plane = true;
                 plane_p = pos.xyz;
                 plane_n = n;
+                light = rsm_views[int(pos.w - 0.5)].params.z;
             }
             int c = (dot(n, plane_n) > 0.9 && abs(dot(pos.xyz - plane_p, plane_n)) < 0.5 * u_grid_cell) ? 0 : 1;
             vec3 f = vpl_flux(rsm_views[int(pos.w - 0.5)], pos.xyz, n, texelFetch(u_rsm_albedo, px, 0).rgb);
@@ -140,7 +145,7 @@ void main() {
         if (weight[c] <= 0.0 || dot(normal[c], normal[c]) == 0.0) continue;
 #if defined(MODE_LIST)
         vpls[2 * (block.y * u_blocks_x + block.x) + c] = Vpl(vec4(position[c] / weight[c], 1.0),
-                                                              vec4(normalize(normal[c]), 0.0), vec4(flux[c], 0.0));
+                                                              vec4(normalize(normal[c]), 0.0), vec4(flux[c], light));
 #else
         inject_lambertian(LpvGrid(u_grid_origin, u_grid_cell, u_grid_size), position[c] / weight[c],
                           normalize(normal[c]), flux[c]);
