@@ -206,7 +206,7 @@ def own_side(clusters: Clusters, cells: np.ndarray, normals: np.ndarray, pos: np
 
 
 def bin_flux(clusters: Clusters, records: np.ndarray, cells: np.ndarray | None = None,
-             normals: np.ndarray | None = None, groups: int = 0) -> tuple[np.ndarray, np.ndarray | float]:
+             normals: np.ndarray | None = None, groups: int | None = None) -> tuple[np.ndarray, np.ndarray | float]:
     """The VPL records' flux (RGB) per cluster. With the clusters' voxels (`cells`, `normals`), a record goes to
     the cluster of its own voxel's side that faces its way (own_side), or leaves the scene where that side faces
     nothing: a record on the outside of a room's wall is not the inside's, however near a cluster of the room that
@@ -216,11 +216,12 @@ def bin_flux(clusters: Clusters, records: np.ndarray, cells: np.ndarray | None =
     block and side within a voxel of it, the one whose plane lies nearest; else
     (a texel in a voxel that the geometry around it claims for another side: a floor's edge at a wall) to the
     nearest cluster facing its way. A record that faces nothing (a sunlit roof's top) leaves the scene, whatever
-    voxel side it shares with other surfaces. Returns ((C, 3), the flux that leaves); with `groups` > 0, binned
-    apart by the records' group (their flux.w: the light, lpv/gather.rsm_records): ((G, C, 3), (G, 3) leaving)."""
+    voxel side it shares with other surfaces. Returns ((C, 3), the flux that leaves); with `groups` (G, an int),
+    binned apart by the records' group (their flux.w: the light, lpv/gather.rsm_records): ((G, C, 3), (G, 3)
+    leaving)."""
     out = np.zeros((clusters.count, 3))
     if len(records) == 0:
-        return (np.zeros((groups, clusters.count, 3)), np.zeros((groups, 3))) if groups else (out, 0.0)
+        return (out, 0.0) if groups is None else (np.zeros((groups, clusters.count, 3)), np.zeros((groups, 3)))
     pos, normal = records["position"][:, :3].astype(np.float64), records["normal"][:, :3].astype(np.float64)
     flux = records["flux"][:, :3].astype(np.float64)
     near = clusters.fine.cell
@@ -249,7 +250,7 @@ def bin_flux(clusters: Clusters, records: np.ndarray, cells: np.ndarray | None =
         d = np.where(facing, np.linalg.norm(gap, axis=2), np.inf)
         target[chunk] = np.where(np.isfinite(d.min(axis=1)), np.argmin(d, axis=1), -1)
     keep = target >= 0
-    if groups:
+    if groups is not None:
         g = records["flux"][:, 3].astype(np.int64)
         slot = g[keep] * clusters.count + target[keep]
         binned = np.stack([np.bincount(slot, flux[keep, i], groups * clusters.count) for i in range(3)], axis=1)

@@ -107,16 +107,15 @@ def voxelize(ctx, programs, scene: Scene, geometry, textures, grid: Grid, mode: 
     nx, ny, nz = grid.size
     used = sorted({m for m, _, _ in geometry.ranges})
     albedo_max, emission_max = material_maxima(scene, used, textures.transport)
-    sides = bool(sides) and mode == "raster" and front_bytes(grid, supersample) <= SIDES_BYTES and \
-        2 * sum(grid.size) <= int(ctx.info.get("GL_MAX_3D_TEXTURE_SIZE", 2048))
+    sides = bool(sides) and mode == "raster" and _sides_fit(ctx, grid, supersample)
     accs = [ctx.texture3d((4 * nx, ny, nz), 1, dtype="u4") for _ in range(5 if sides else 4)]
     flags = ctx.texture3d((1, 1, 1), 1, np.zeros(1, np.uint32).tobytes(), dtype="u4")
     for t in accs + [flags]:
         t.filter = (moderngl.NEAREST, moderngl.NEAREST)
     patches = _tessellation_buffers(ctx, scene, grid, supersample) if mode == "tessellation" else None
     own_front = sides and front is None
-    fronts = [] if not sides else [front] if front is not None else \
-        _front_most(ctx, programs, scene, geometry, textures, grid, supersample)
+    fronts = ([front] if front is not None else _front_most(ctx, programs, scene, geometry, textures, grid,
+                                                             supersample)) if sides else []
     try:
         reruns = 0
         while True:
@@ -147,6 +146,12 @@ def voxelize(ctx, programs, scene: Scene, geometry, textures, grid: Grid, mode: 
     return VoxelVolumes(grid, *volumes[:4], mode=mode, supersample=supersample, scale_bits=scale_bits,
                         reruns=reruns, albedo_back=volumes[4] if sides else None,
                         front=fronts[0] if own_front and keep_front else None)
+
+
+def _sides_fit(ctx, grid: Grid, supersample: int) -> bool:
+    """Whether sides=True's front-most image fits SIDES_BYTES and the 3D texture size limit."""
+    return front_bytes(grid, supersample) <= SIDES_BYTES and \
+        2 * sum(grid.size) <= int(ctx.info.get("GL_MAX_3D_TEXTURE_SIZE", 2048))
 
 
 def front_bytes(grid: Grid, supersample: int) -> int:

@@ -258,8 +258,7 @@ def test_pipeline_reruns_only_what_changed(engine, settings):
     np.testing.assert_array_equal(third.passes["Position"], first.passes["Position"])
 
     # Change only the camera: G-buffer, lighting and compose re-run; geometry, textures, shadow maps do not.
-    cam2 = camera((3.0, -6.0, 7.0))
-    turned = make_scene(sun(-50.0), cam2)
+    turned = make_scene(sun(-50.0), cam2 := camera((3.0, -6.0, 7.0)))
     fourth = engine.render(turned, settings)
     assert set(fourth.skipped) == {"geometry", "textures", "emitter_shells", "shadow_maps"}
     assert not np.array_equal(fourth.passes["Position"], third.passes["Position"])
@@ -281,8 +280,7 @@ def test_pipeline_reruns_only_what_changed(engine, settings):
     sixth = engine.render(recoloured, settings)
     assert set(sixth.skipped) == kept
     brighter = make_scene(sun(-50.0), cam2)
-    brighter.world.color = (0.3, 0.2, 0.1)
-    brighter.lights[0].power *= 2.0
+    brighter.world.color, brighter.lights[0].power = (0.3, 0.2, 0.1), 2.0 * brighter.lights[0].power
     seventh = engine.render(brighter, settings)
     assert set(seventh.skipped) == kept
     from bounce_gi.gpu_kernels.engine import Engine
