@@ -30,10 +30,10 @@ from .state import LpvGridState, cascade_grids
 
 # Outputs kept per pass (gl/pass_cache.py): the geometry's passes for two settings (the live viewport's draft and
 # final stages use two grids; each would otherwise rebuild its transfer on every edit).
+KEEP = {name: 2 for name in ("geometry_volume", "lpv_albedo", "lpv_transfer", "lpv_transfer_albedo")}
 # An orthographic RSM view (a sun's) needs no finer texels than this many per LPV cell: two per surface voxel
 # (half a cell), into which its texels' flux is binned (lpv/rsm.view_resolution).
 RSM_TEXELS_PER_CELL = 2
-KEEP = {name: 2 for name in ("geometry_volume", "lpv_albedo", "lpv_transfer", "lpv_transfer_albedo")}
 
 
 def run(frame) -> MethodOutput:
