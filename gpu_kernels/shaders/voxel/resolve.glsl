@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Compute passes around voxelisation (Freed 2018, §4.1): MODE_CLEAR zeroes the fixed-point accumulators,
+// The compute pass after voxelisation (Freed 2018, §4.1; voxel/voxelize.py zeroes the accumulators before it):
 // MODE_RESOLVE turns their integer sums (voxel/common.glsl) into the RGBA32F volumes:
 //   area     rgb = Σ A|n.x|, Σ A|n.y|, Σ A|n.z| (m²), a = Σ A (m²)
 //   albedo   rgb = Σ A·albedo / Σ A, a = opacity = min(1, max projected area / cell²)
@@ -10,30 +10,6 @@
 // Pure integer→float arithmetic per voxel: deterministic.
 layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
 uniform ivec3 u_grid_size;
-
-#if defined(MODE_CLEAR)
-layout(binding = 0, r32ui) uniform writeonly uimage3D u_acc0;
-layout(binding = 1, r32ui) uniform writeonly uimage3D u_acc1;
-layout(binding = 2, r32ui) uniform writeonly uimage3D u_acc2;
-layout(binding = 3, r32ui) uniform writeonly uimage3D u_acc3;
-#if defined(SIDES)
-layout(binding = 4, r32ui) uniform writeonly uimage3D u_acc4;
-#endif
-void main() {
-    ivec3 v = ivec3(gl_GlobalInvocationID);
-    if (any(greaterThanEqual(v, u_grid_size))) return;
-    for (int c = 0; c < 4; ++c) {
-        ivec3 t = ivec3(4 * v.x + c, v.y, v.z);
-        imageStore(u_acc0, t, uvec4(0u));
-        imageStore(u_acc1, t, uvec4(0u));
-        imageStore(u_acc2, t, uvec4(0u));
-        imageStore(u_acc3, t, uvec4(0u));
-#if defined(SIDES)
-        imageStore(u_acc4, t, uvec4(0u));
-#endif
-    }
-}
-#endif
 
 #if defined(MODE_RESOLVE)
 uniform usampler3D u_acc_area;
