@@ -8,7 +8,7 @@ Two methods, as compared in Freed 2018, §5.2.2 / Table 5.2:
     (voxel/raster.glsl).
   * ``mode="tessellation"`` (§4.1.2, after Fei et al. 2012): the tessellator cuts each triangle into sub-triangles
     smaller than 1/supersample voxel; a geometry shader deposits each at its centroid, with its exact area.
-    Triangles needing a level above GL_MAX_TESS_GEN_LEVEL are split on the CPU first (`split_for_tessellation`).
+    Triangles needing a level above GL_MAX_TESS_GEN_LEVEL are split on the CPU first (voxel/tessellate.py).
 
 With ``sides=True`` (raster only) the albedo is kept per side of each voxel, covered surfaces left out of the side
 they are hidden from (voxel/raster.glsl): `VoxelVolumes.albedo_back` holds the back side's.
@@ -27,14 +27,12 @@ import numpy as np
 
 from ..common.grid import Grid
 from ..direct.geometry import bind_material
-from ..gl import preprocessor as spp
-from ..gl.bind import bind_images, bind_named, dispatch, set_uniform, set_uniforms, zero_texture
+from ..gl.bind import bind_named, dispatch, set_uniform, set_uniforms, zero_texture
 from ..scene import Scene
+from .tessellate import draw_tessellated, patch_buffers
 
 MODES = ("raster", "tessellation")
 DEFAULT_SCALE_BITS = 24      # fixed point: 2^-24 cell² per unit, 2^8 = 256 cell² of surface per voxel before wrap
-MAX_TESS_LEVEL = 64          # GL_MAX_TESS_GEN_LEVEL is at least 64 everywhere (and exactly 64 on llvmpipe)
-TESS_VERTEX_BUDGET = 16384   # tessellated vertices per draw call (half of what llvmpipe handles, see below)
 DILATION_PX = 0.5 + 1.0 / 64.0   # half a pixel, plus slack for the rasteriser's 1/256-pixel vertex snapping
 VOLUME_NAMES = ("area", "albedo", "normal", "emission")
 SIDES_BYTES = 256 * 2 ** 20  # the front-most image's budget for sides=True; larger grids keep one albedo
@@ -62,11 +60,15 @@ class VoxelVolumes:
     reruns: int = 0          # re-runs after a fixed-point overflow (0 normally)
     albedo_back: object = None
     front: object = None     # sides=True, keep_front=True: the front-most image, the caller's to release or reuse
+    position: object = None  # positions=True: rgb the surfaces' area-weighted centroid, cells from the voxel's corner
+    extent_lo: object = None  # positions=True: rgb the box the surfaces span, likewise
+    extent_hi: object = None
 
     def textures(self) -> dict:
         out = {name: getattr(self, name) for name in VOLUME_NAMES}
-        if self.albedo_back is not None:
-            out["albedo_back"] = self.albedo_back
+        for name in ("albedo_back", "position", "extent_lo", "extent_hi"):
+            if getattr(self, name) is not None:
+                out[name] = getattr(self, name)
         return out
 
     def read(self, names=None) -> dict:
@@ -88,7 +90,7 @@ class VoxelVolumes:
 
 def voxelize(ctx, programs, scene: Scene, geometry, textures, grid: Grid, mode: str = "raster",
              supersample: int = 2, scale_bits: int = DEFAULT_SCALE_BITS, sides: bool = False, front=None,
-             keep_front: bool = False) -> VoxelVolumes:
+             keep_front: bool = False, axis_only: int = -1, positions: bool = False) -> VoxelVolumes:
     """Voxelise the scene's surfaces into `grid` (GL thread); returns new textures the caller releases.
 
     `geometry`: direct/geometry.GeometryBuffers of `scene` (raster draws its VBO; tessellation uploads its own patch
@@ -99,45 +101,44 @@ def voxelize(ctx, programs, scene: Scene, geometry, textures, grid: Grid, mode: 
     `sides`: keep the albedo per side, covered surfaces left out of the side they are hidden from (raster only);
     the front-most image this needs depends on the geometry alone: `keep_front` hands it over in the result's
     `front`, and `front` takes one back (same geometry, grid and supersample) instead of rasterising it again.
+    `axis_only` (raster only) ≥ 0 voxelises only the triangles whose dominant axis it is (x, y, z: 0, 1, 2) — the
+    LPV's receivers, one per voxel and axis (lpv/occlusion.py) — and −1 all of them. The front-most image is per
+    dominant axis, so one made of every triangle serves each axis. `positions` (raster only) adds the surfaces'
+    area-weighted centroid and box per voxel (VoxelVolumes.position, extent_lo, extent_hi).
     """
     import moderngl
 
     _check_grid(ctx, grid, mode, supersample)
+    if (axis_only >= 0 or positions) and mode != "raster":
+        raise ValueError("axis_only and positions need mode='raster'")
     supersample = int(supersample)
     nx, ny, nz = grid.size
     used = sorted({m for m, _, _ in geometry.ranges})
     albedo_max, emission_max = material_maxima(scene, used, textures.transport)
     sides = bool(sides) and mode == "raster" and _sides_fit(ctx, grid, supersample)
-    accs = [ctx.texture3d((4 * nx, ny, nz), 1, dtype="u4") for _ in range(5 if sides else 4)]
+    positions = bool(positions)
+    accs = [ctx.texture3d((4 * nx, ny, nz), 1, dtype="u4") for _ in range(4 + sides)]
+    accs += [ctx.texture3d((4 * nx, 3 * ny, nz), 1, dtype="u4")] * positions  # voxel/common.glsl acc_position
     flags = ctx.texture3d((1, 1, 1), 1, np.zeros(1, np.uint32).tobytes(), dtype="u4")
     for t in accs + [flags]:
         t.filter = (moderngl.NEAREST, moderngl.NEAREST)
-    patches = _tessellation_buffers(ctx, scene, grid, supersample) if mode == "tessellation" else None
+    patches = patch_buffers(ctx, scene, grid, supersample) if mode == "tessellation" else None
     own_front = sides and front is None
     fronts = ([front] if front is not None else _front_most(ctx, programs, scene, geometry, textures, grid,
                                                              supersample)) if sides else []
+    # image units of voxel/common.glsl: 0–3 accumulators, 4 flags, 5 albedo_back, 6 front-most, 7 positions
+    images = list(zip([0, 1, 2, 3] + [5] * sides + [7] * positions + [4] + [6] * len(fronts), accs + [flags] + fronts))
+    defines = {**({"SIDES": None} if sides else {}), **({"POSITIONS": None} if positions else {})}
+    uniforms = {"u_grid_origin": grid.origin, "u_inv_cell": 1.0 / grid.cell, "u_grid_size": grid.size,
+                "u_supersample": float(supersample), "u_albedo_max": albedo_max, "u_emission_max": emission_max,
+                "u_axis_only": int(axis_only)}
     try:
         reruns = 0
-        while True:
-            _clear(ctx, accs)
-            flags.write(np.zeros(1, np.uint32).tobytes())
-            uniforms = {"u_grid_origin": grid.origin, "u_inv_cell": 1.0 / grid.cell, "u_grid_size": grid.size,
-                        "u_supersample": float(supersample), "u_albedo_max": albedo_max,
-                        "u_emission_max": emission_max, "u_fixed_scale": float(2.0 ** scale_bits)}
-            for unit, t in enumerate(accs[:4] + [flags] + accs[4:] + fronts):  # units of voxel/common.glsl
-                t.bind_to_image(unit, read=True, write=True)
-            if mode == "raster":
-                _draw_raster(ctx, programs, scene, geometry, textures, grid, supersample, uniforms,
-                             {"SIDES": None} if sides else None)
-            else:
-                _draw_tessellated(ctx, programs, scene, patches, textures, uniforms)
-            ctx.memory_barrier()
-            overflow = np.frombuffer(flags.read(), np.uint32)[0] != 0
-            if not overflow or scale_bits <= 0:
-                break
+        while _deposit(ctx, programs, scene, (geometry, patches), textures, grid, supersample,
+                       {**uniforms, "u_fixed_scale": float(2.0 ** scale_bits)}, images, defines) and scale_bits > 0:
             scale_bits = _smaller_scale(scene, grid, scale_bits, reruns)
             reruns += 1
-        volumes = _resolve(ctx, programs, accs, grid, scale_bits, albedo_max, emission_max)
+        volumes = _resolve(ctx, programs, accs, grid, scale_bits, albedo_max, emission_max, sides, positions)
     finally:
         for t in accs + [flags] + (fronts if own_front and not keep_front else []):
             t.release()
@@ -145,7 +146,29 @@ def voxelize(ctx, programs, scene: Scene, geometry, textures, grid: Grid, mode: 
             patches[0].release()
     return VoxelVolumes(grid, *volumes[:4], mode=mode, supersample=supersample, scale_bits=scale_bits,
                         reruns=reruns, albedo_back=volumes[4] if sides else None,
-                        front=fronts[0] if own_front and keep_front else None)
+                        front=fronts[0] if own_front and keep_front else None,
+                        **dict(zip(("position", "extent_lo", "extent_hi"), volumes[-3:] if positions else ())))
+
+
+def _deposit(ctx, programs, scene, buffers, textures, grid, supersample, uniforms, images, defines) -> bool:
+    """One voxelisation pass into the accumulators, zeroed first (`images`: (unit, texture) of voxel/common.glsl,
+    the flags at unit 4 and the front-most image, read only, at 6), drawn from `buffers` = (geometry, tessellation
+    patches or None); True where a voxel's area sum wrapped."""
+    geometry, patches = buffers
+    for unit, t in images:
+        if unit not in (4, 6):  # a copy from a zero buffer (gl/bind.zero_texture): faster than a compute pass
+            zero_texture(ctx, t)
+    ctx.memory_barrier()
+    flags = dict(images)[4]
+    flags.write(np.zeros(1, np.uint32).tobytes())
+    for unit, t in images:
+        t.bind_to_image(unit, read=True, write=True)
+    if patches is None:
+        _draw_raster(ctx, programs, scene, geometry, textures, grid, supersample, uniforms, defines or None)
+    else:
+        draw_tessellated(ctx, programs, scene, patches, textures, uniforms)
+    ctx.memory_barrier()
+    return bool(np.frombuffer(flags.read(), np.uint32)[0])
 
 
 def _sides_fit(ctx, grid: Grid, supersample: int) -> bool:
@@ -171,7 +194,7 @@ def _front_most(ctx, programs, scene, geometry, textures, grid, supersample) -> 
     zero_texture(ctx, front)
     front.bind_to_image(6, read=True, write=True)
     uniforms = {"u_grid_origin": grid.origin, "u_inv_cell": 1.0 / grid.cell, "u_grid_size": grid.size,
-                "u_supersample": float(supersample)}
+                "u_supersample": float(supersample), "u_axis_only": -1}
     _draw_raster(ctx, programs, scene, geometry, textures, grid, supersample, uniforms, {"MODE_FRONT": None})
     ctx.memory_barrier()
     return [front]
@@ -224,79 +247,6 @@ def material_maxima(scene: Scene, used, transport: np.ndarray) -> tuple[float, f
     return (albedo if albedo > 0 else 1.0), (emission if emission > 0 else 0.0)
 
 
-def split_for_tessellation(positions: np.ndarray, cell: float, supersample: int,
-                           max_level: int = MAX_TESS_LEVEL) -> tuple[np.ndarray, np.ndarray]:
-    """Freed 2018, §4.1.2 / §5.2.2 footnote 3: split triangles whose longest edge needs a tessellation level above
-    `max_level` (level = ceil(edge / cell · supersample)) into m² congruent sub-triangles (m = ceil(level /
-    max_level)), so none needs more than the hardware gives. Returns (source triangle index, barycentric corner
-    weights (S, 3, 3)) per output triangle, sources in input order; orientation is preserved."""
-    need = np.ceil(_longest_edge(positions) / float(cell) * supersample)  # the level the control shader wants
-    m = np.maximum(1, np.ceil(need / max_level)).astype(np.int64)
-    src, bary = [], []
-    for mm in np.unique(m):
-        idx = np.flatnonzero(m == mm)
-        lat = _lattice(int(mm))
-        src.append(np.repeat(idx, len(lat)))
-        bary.append(np.tile(lat, (len(idx), 1, 1)))
-    if not src:
-        return np.zeros(0, np.int64), np.zeros((0, 3, 3))
-    src, bary = np.concatenate(src), np.concatenate(bary)
-    order = np.argsort(src, kind="stable")
-    return src[order], bary[order]
-
-
-def _lattice(m: int) -> np.ndarray:
-    """Barycentric weights (m², 3 corners, 3 weights) of the regular m-subdivision of a triangle."""
-    tris = []
-    for i in range(m):
-        for j in range(m - i):
-            tris.append([(i, j), (i + 1, j), (i, j + 1)])
-            if i + j <= m - 2:
-                tris.append([(i + 1, j), (i + 1, j + 1), (i, j + 1)])
-    ij = np.asarray(tris, np.float64) / m                       # (m², 3, 2): weights of corners 1 and 2
-    return np.concatenate([1.0 - ij.sum(axis=2, keepdims=True), ij], axis=2)
-
-
-def tessellation_levels(positions: np.ndarray, cell: float, supersample: int) -> np.ndarray:
-    """Per triangle, the inner level voxel/tess.glsl's control shader will pick (max edge level, ≤ 64)."""
-    return np.clip(np.ceil(_longest_edge(positions) / float(cell) * supersample), 1, MAX_TESS_LEVEL)
-
-
-def _longest_edge(positions: np.ndarray) -> np.ndarray:
-    p = np.asarray(positions, np.float64).reshape(-1, 3, 3)
-    return np.linalg.norm(p[:, [1, 2, 0]] - p, axis=2).max(axis=1)
-
-
-def _tessellation_buffers(ctx, scene: Scene, grid: Grid, supersample: int):
-    """The patch VBO (same 11-float layout as direct/geometry.upload_geometry; normals unused) with oversized triangles
-    split, grouped by material, and draw ranges cut so no draw generates more than TESS_VERTEX_BUDGET vertices.
-
-    Why the cut: Mesa 22.3.6 llvmpipe's tessellator (measured here) hands the geometry shader sub-triangles made
-    of the wrong vertices once one draw generates more than about 32768 tessellated vertices (measured: identical
-    level-64 patches go wrong from the 12th in one draw; areas then come out several times too large).
-    """
-    src, bary = split_for_tessellation(scene.positions, grid.cell, supersample)
-    order = np.argsort(scene.material_index[src], kind="stable")
-    src, bary = src[order], bary[order]
-    pos = np.einsum("scw,swd->scd", bary, np.asarray(scene.positions, np.float64)[src])
-    uvs = np.einsum("scw,swd->scd", bary, np.asarray(scene.uvs, np.float64)[src])
-    data = np.zeros((len(src), 3, 11), np.float32)
-    data[..., 0:3], data[..., 6:8] = pos, uvs
-    # Upper bound on tessellated vertices per patch at level n (3169 measured at n = 64, 61 at n = 8).
-    n = tessellation_levels(pos, grid.cell, supersample)
-    cost = np.cumsum(0.78 * n * n + 3.0 * n + 3.0)
-    mats = scene.material_index[src]
-    ranges = []
-    starts = np.flatnonzero(np.r_[True, mats[1:] != mats[:-1]]) if len(mats) else np.zeros(0, int)
-    for s, e in zip(starts, np.r_[starts[1:], len(mats)]):
-        while s < e:
-            base = cost[s - 1] if s > 0 else 0.0
-            stop = max(s + 1, min(e, int(np.searchsorted(cost, base + TESS_VERTEX_BUDGET, side="right"))))
-            ranges.append((int(mats[s]), int(s) * 3, int(stop - s) * 3))
-            s = stop
-    return ctx.buffer(data.tobytes() or b"\0" * 44), ranges
-
-
 def _draw_raster(ctx, programs, scene, geometry, textures, grid, supersample, uniforms, defines=None) -> None:
     import moderngl
 
@@ -320,68 +270,18 @@ def _draw_raster(ctx, programs, scene, geometry, textures, grid, supersample, un
         fbo.release()
 
 
-def _draw_tessellated(ctx, programs, scene, buffers, textures, uniforms) -> None:
-    import moderngl
-
-    vbo, ranges = buffers
-    prog = tessellation_program(programs, "voxel/tess.glsl")
-    set_uniforms(prog, {**uniforms, "u_max_level": float(MAX_TESS_LEVEL)})
-    vao = ctx.vertex_array(prog, [(vbo, "3f 12x 2f 12x", "in_position", "in_uv")])
-    fbo = ctx.empty_framebuffer((1, 1))   # draws need a complete framebuffer even with the rasteriser off
-    ctx.enable(moderngl.RASTERIZER_DISCARD)   # §4.1.2: no rasterisation; the geometry shader writes the voxels
-    try:
-        fbo.use()
-        ctx.patch_vertices = 3
-        for mat_index, first, count in ranges:
-            bind_material(prog, scene, mat_index, textures)
-            vao.render(moderngl.PATCHES, vertices=count, first=first)
-    finally:
-        ctx.disable(moderngl.RASTERIZER_DISCARD)
-        vao.release()
-        fbo.release()
-
-
-_TESS_STAGES = (("vertex_shader", "VERTEX_SHADER"), ("tess_control_shader", "TESS_CONTROL_SHADER"),
-                ("tess_evaluation_shader", "TESS_EVALUATION_SHADER"), ("geometry_shader", "GEOMETRY_SHADER"))
-
-
-def tessellation_program(programs, name: str, defines: dict | None = None):
-    """Compile a vertex + tessellation + geometry program (no fragment stage) from one .glsl file.
-
-    ProgramCache/gl.preprocessor only know vertex/fragment/geometry/compute stages, so the stage macro is
-    injected as an ordinary define (every stage then has the same header length, so one line map serves the
-    error report). The program is stored in the ProgramCache's table so `programs.release()` frees it.
-    """
-    table = getattr(programs, "_programs", None)
-    if table is None:
-        table = programs.__dict__.setdefault("_voxelize_programs", {})
-    key = ("tessellation", name, tuple(sorted((defines or {}).items())))
-    if key not in table:
-        stages = {arg: spp.load(name, {**(defines or {}), macro: None}) for arg, macro in _TESS_STAGES}
-        try:
-            table[key] = programs.ctx.program(**{arg: src.text for arg, src in stages.items()})
-        except Exception as exc:  # moderngl raises a plain Error carrying the driver log
-            raise spp.ShaderCompileError(spp.format_compile_error(str(exc), stages["vertex_shader"])) from None
-    return table[key]
-
-
-def _clear(ctx, accs) -> None:
-    """Zero the accumulators: a copy from a zero buffer (gl/bind.zero_texture), 20 ms less than a compute pass over
-    five 4·66 × 66 × 66 images on llvmpipe."""
-    for t in accs:
-        zero_texture(ctx, t)
-    ctx.memory_barrier()
-
-
-def _resolve(ctx, programs, accs, grid, scale_bits, albedo_max, emission_max) -> list:
-    """The volumes of VOLUME_NAMES, then albedo_back when `accs` has its fifth (sides) accumulator."""
-    sides = len(accs) > 4
-    prog = programs.compute("voxel/resolve.glsl", {"MODE_RESOLVE": None, **({"SIDES": None} if sides else {})})
+def _resolve(ctx, programs, accs, grid, scale_bits, albedo_max, emission_max, sides, positions) -> list:
+    """The volumes of VOLUME_NAMES, then albedo_back (`sides`), then position (`positions`), from `accs` in that
+    order."""
+    defines = {"MODE_RESOLVE": None, **({"SIDES": None} if sides else {}), **({"POSITIONS": None} if positions else {})}
+    prog = programs.compute("voxel/resolve.glsl", defines)
     nx, ny, nz = grid.size
-    out = [ctx.texture3d((nx, ny, nz), 4, dtype="f4") for _ in range(len(VOLUME_NAMES) + sides)]
-    names = ("u_acc_area", "u_acc_albedo", "u_acc_normal", "u_acc_emission", "u_acc_albedo_back")
+    out = [ctx.texture3d((nx, ny, nz), 4, dtype="f4") for _ in range(len(VOLUME_NAMES) + sides + 3 * positions)]
+    names = ["u_acc_area", "u_acc_albedo", "u_acc_normal", "u_acc_emission"] + ["u_acc_albedo_back"] * sides + \
+        ["u_acc_position"] * positions
     bind_named(prog, list(zip(names, accs)))
-    bind_images(out)
+    for unit, t in zip([0, 1, 2, 3] + [4] * sides + [5, 6, 7] * positions, out):  # voxel/resolve.glsl's bindings
+        t.bind_to_image(unit, read=False, write=True)
     cell_area = grid.cell ** 2
     set_uniforms(prog, {"u_grid_size": grid.size, "u_unit_area": cell_area / 2.0 ** scale_bits, "u_cell_area": cell_area,
                         "u_albedo_max": albedo_max, "u_emission_max": emission_max})

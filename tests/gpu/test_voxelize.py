@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 from bounce_gi.gpu_kernels.direct import geometry as direct
+from bounce_gi.gpu_kernels.voxel import tessellate as vt
 from bounce_gi.gpu_kernels.voxel import voxelize as vz
 from bounce_gi.gpu_kernels.common.grid import LATTICE_PHASE, Grid
 from bounce_gi.gpu_kernels.gl.programs import ProgramCache
@@ -303,11 +304,11 @@ def test_fixed_point_overflow_is_detected_and_rerun(gl, mode):
 
 def test_split_for_tessellation_bounds_levels_and_keeps_area():
     tri = np.array([[[0, 0, 0], [300, 0, 0], [0, 170, 0]], [[0, 0, 0], [1, 0, 0], [0, 1, 1]]], np.float64)
-    src, bary = vz.split_for_tessellation(tri, cell=1.0, supersample=2)
+    src, bary = vt.split_for_tessellation(tri, cell=1.0, supersample=2)
     pieces = np.einsum("scw,swd->scd", bary, tri[src])
-    assert vz.tessellation_levels(pieces, 1.0, 2).max() <= vz.MAX_TESS_LEVEL
+    assert vt.tessellation_levels(pieces, 1.0, 2).max() <= vt.MAX_TESS_LEVEL
     longest = np.linalg.norm(pieces[:, [1, 2, 0]] - pieces, axis=2).max(axis=1)
-    assert longest.max() * 2 <= vz.MAX_TESS_LEVEL  # every piece within the hardware's level
+    assert longest.max() * 2 <= vt.MAX_TESS_LEVEL  # every piece within the hardware's level
     assert np.count_nonzero(src == 1) == 1  # a small triangle is left alone
     area = 0.5 * np.linalg.norm(np.cross(pieces[:, 1] - pieces[:, 0], pieces[:, 2] - pieces[:, 0]), axis=1)
     assert area[src == 0].sum() == pytest.approx(0.5 * 300 * 170, rel=1e-12)
@@ -360,3 +361,36 @@ def test_a_floor_at_zero_lies_inside_a_voxel_at_every_scale():
         for cell in (g.cell / 2, g.cell, g.cell * 2):
             f = (0.0 - g.origin[2]) / cell % 1.0
             assert 0.1 < f < 0.9, (scale, cell, f)
+
+
+# --------------------------------------------------------------------------- where surfaces lie, by axis
+
+def test_positions_give_each_voxels_surfaces_centroid_and_box_and_axis_only_keeps_one_axis(gl):
+    """positions=True: a floor at z = 0.3 cells into its voxels and a wall at x = 0.7 cells into its own, cut by the
+    grid: every voxel's centroid and box (voxel fractions) are the pieces' own, exactly (the clipped polygons'
+    centroids and corners; float32 rounding, 1e-5). axis_only keeps only the triangles of that dominant axis: the
+    floor alone with 2 (z), the wall alone with 0 (x), and the two add up to all of them."""
+    grid = Grid((0.0, 0.0, 0.0), 1.0, (4, 4, 4))
+    floor = quad([(0.5, 0.5, 1.3), (3.5, 0.5, 1.3), (3.5, 3.5, 1.3), (0.5, 3.5, 1.3)])
+    wall = quad([(2.7, 0.5, 0.5), (2.7, 3.5, 0.5), (2.7, 3.5, 3.5), (2.7, 0.5, 3.5)])
+    scene = make_scene(np.concatenate([floor, wall]))
+    both, _ = run(gl, scene, grid, "raster", positions=True)
+    z_only, _ = run(gl, scene, grid, "raster", positions=True, axis_only=2)
+    x_only, _ = run(gl, scene, grid, "raster", positions=True, axis_only=0)
+    np.testing.assert_allclose(z_only["area"] + x_only["area"], both["area"], rtol=1e-6, atol=1e-9)
+    for data, axis, at in ((z_only, 2, 0.3), (x_only, 0, 0.7)):
+        has = data["area"][..., 3] > 0
+        assert has.sum() == 16  # the quad crosses 4 × 4 voxels
+        occupied = np.argwhere(has)  # (z, y, x)
+        assert (occupied[:, 2 - axis] == (1 if axis == 2 else 2)).all()  # the floor in z-layer 1, the wall in x-layer 2
+        np.testing.assert_allclose(data["position"][has][:, axis], at, atol=1e-5)
+        np.testing.assert_allclose(data["extent_lo"][has][:, axis], at, atol=1e-5)
+        np.testing.assert_allclose(data["extent_hi"][has][:, axis], at, atol=1e-5)
+        # in the plane: the quad spans 0.5 … 3.5, so the edge voxels hold half of themselves, the others all
+        for i in (a for a in range(3) if a != axis):
+            index = occupied[:, 2 - i]
+            lo = np.where(index == 0, 0.5, 0.0)
+            hi = np.where(index == 3, 0.5, 1.0)
+            np.testing.assert_allclose(data["extent_lo"][has][:, i], lo, atol=1e-5)
+            np.testing.assert_allclose(data["extent_hi"][has][:, i], hi, atol=1e-5)
+            np.testing.assert_allclose(data["position"][has][:, i], (lo + hi) / 2, atol=1e-5)

@@ -13,6 +13,10 @@
 //   acc_emission: A·emission.rgb / u_emission_max      (unsigned; .w unused)
 // With SIDES (voxel/voxelize.py sides=True) the albedo is kept per side of the voxel: acc_albedo holds what the
 // side its canonical normals point to sees (.w: the area seen from there), acc_albedo_back the other side's.
+// With POSITIONS (voxel/voxelize.py positions=True) acc_position, (4·nx, 3·ny, nz), holds in its rows [0, ny)
+// A·(the piece's centroid − the voxel's min corner, in cells), so the voxel's surfaces have an area-weighted
+// centroid, and in rows [ny, 2ny) and [2ny, 3ny) the largest 1 − (its lowest corner) and highest corner, in
+// 1/65535 of a cell (atomic max from zero): the box its surfaces span inside the voxel.
 // Every channel is rounded from a value ≤ the area value, and rounding is monotone, so no channel can exceed
 // the total-area channel: checking that one channel for wrap-around guards them all.
 #pragma once
@@ -35,6 +39,9 @@ layout(binding = 4, r32ui) uniform uimage3D u_flags;   // 1×1×1; bit 0 set whe
 #if defined(SIDES)
 layout(binding = 5, r32ui) uniform uimage3D u_acc_albedo_back;
 #endif
+#if defined(POSITIONS)
+layout(binding = 7, r32ui) uniform uimage3D u_acc_position;
+#endif
 uniform ivec3 u_grid_size;            // grid size (nx, ny, nz)
 
 // Albedo of a voxel surfel: what the surface reflects of the light reaching it, averaged over directions
@@ -55,9 +62,10 @@ vec3 canonical_normal(vec3 n) {
 #define MIN_PIECE_UNITS 64.0
 uint fixed_round(float x) { return uint(x + 0.5); }   // x ≥ 0; monotone, so channel ≤ area channel holds
 
-// Add one surface piece of `area_cells` (area in cell² units) with unit normal `n` to voxel `v`; `seen`: whether
-// its side along canonical_normal(n) (x) and its other side (y) are uncovered (SIDES only: voxel/raster.glsl).
-void deposit_seen(ivec3 v, float area_cells, vec3 n, vec3 albedo, bvec2 seen) {
+// Add one surface piece of `area_cells` (area in cell² units) with unit normal `n`, centroid offset.xyz and box
+// [lo, hi] (cells from the voxel's min corner) to voxel `v`; `seen`: whether its side along canonical_normal(n)
+// (x) and its other side (y) are uncovered (SIDES only: voxel/raster.glsl).
+void deposit_seen(ivec3 v, float area_cells, vec3 n, vec3 albedo, bvec2 seen, vec3 offset, vec3 lo, vec3 hi) {
     if (any(lessThan(v, ivec3(0))) || any(greaterThanEqual(v, u_grid_size)) || !(area_cells > 0.0)) return;
     // A piece with positive area counts at least MIN_PIECE_UNITS, so occupancy (area > 0) never loses a voxel a
     // surface really crosses and a voxel holding only slivers still gets a mean albedo/normal to 1/64; the bias
@@ -90,6 +98,17 @@ void deposit_seen(ivec3 v, float area_cells, vec3 n, vec3 albedo, bvec2 seen) {
     imageAtomicAdd(u_acc_albedo, t + ivec3(1, 0, 0), fixed_round(alb.g));
     imageAtomicAdd(u_acc_albedo, t + ivec3(2, 0, 0), fixed_round(alb.b));
 #endif
+#if defined(POSITIONS)
+    vec3 at = a * clamp(offset, vec3(0.0), vec3(1.0));
+    uvec3 below = uvec3((1.0 - clamp(lo, vec3(0.0), vec3(1.0))) * 65535.0 + 0.5);
+    uvec3 above = uvec3(clamp(hi, vec3(0.0), vec3(1.0)) * 65535.0 + 0.5);
+    ivec3 row = ivec3(0, u_grid_size.y, 0);
+    for (int c = 0; c < 3; ++c) {
+        imageAtomicAdd(u_acc_position, t + ivec3(c, 0, 0), fixed_round(at[c]));
+        imageAtomicMax(u_acc_position, t + ivec3(c, 0, 0) + row, below[c]);
+        imageAtomicMax(u_acc_position, t + ivec3(c, 0, 0) + 2 * row, above[c]);
+    }
+#endif
     vec3 c = canonical_normal(n) * (0.5 * a);
     imageAtomicAdd(u_acc_normal, t, uint(int(round(c.x))));
     imageAtomicAdd(u_acc_normal, t + ivec3(1, 0, 0), uint(int(round(c.y))));
@@ -103,5 +122,5 @@ void deposit_seen(ivec3 v, float area_cells, vec3 n, vec3 albedo, bvec2 seen) {
 }
 
 void deposit(ivec3 v, float area_cells, vec3 n, vec3 albedo) {
-    deposit_seen(v, area_cells, n, albedo, bvec2(true));
+    deposit_seen(v, area_cells, n, albedo, bvec2(true), vec3(0.5), vec3(0.0), vec3(1.0));
 }

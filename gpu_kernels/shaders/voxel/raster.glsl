@@ -42,6 +42,7 @@ in vec2 v_uv[];
 uniform float u_supersample;    // pixels per voxel along each axis
 uniform vec2 u_viewport;        // framebuffer size in pixels
 uniform float u_dilation;       // half-pixel plus a margin for the rasteriser's subpixel snapping
+uniform int u_axis_only;        // ≥ 0: only the triangles whose dominant axis this is (voxelize axis_only)
 flat out vec2 g_p[3];           // the undilated triangle in pixel units of the dominant plane
 flat out vec2 g_uv[3];
 flat out vec3 g_normal;         // unit geometric normal (grid space = world directions)
@@ -66,6 +67,7 @@ void main() {
     n /= len;
     vec3 an = abs(n);
     int axis = (an.x >= an.y && an.x >= an.z) ? 0 : (an.y >= an.z ? 1 : 2);
+    if (u_axis_only >= 0 && axis != u_axis_only) return;
     vec3 np = to_plane(n, axis);
     vec2 q[3];
     for (int i = 0; i < 3; ++i) q[i] = to_plane(v_grid[i], axis).xy * u_supersample;
@@ -152,6 +154,7 @@ float poly_area(vec2 p[MAXV], int n, out vec2 center) {
 
 // Voxel (u, v, depth) in the dominant plane's frame → grid (x, y, z); inverse of to_plane.
 ivec3 from_plane(ivec3 c, int axis) { return axis == 0 ? c.zxy : (axis == 1 ? c.yzx : c); }
+vec3 from_plane(vec3 c, int axis) { return axis == 0 ? c.zxy : (axis == 1 ? c.yzx : c); }
 
 #if defined(MODE_FRONT) || defined(SIDES)
 // Per pixel column, dominant axis a and voxel layer k along it: layer offset(a) + 2k the largest nearest-depth
@@ -232,7 +235,20 @@ void main() {
         seen = bvec2(to_front(f_hi) + FRONT_TOLERANCE >= front_load(front_texel(k, 0)),
                      to_front(1.0 - f_lo) + FRONT_TOLERANCE >= front_load(front_texel(k, 1)));
 #endif
-        deposit_seen(from_plane(ivec3(col, k), g_axis), area_px * g_area_per_px, g_normal, voxel_albedo(uv), seen);
+        // The piece's centroid and box in the plane frame (pixels / supersample = cells; depth in cells) → the
+        // voxel's frame.
+        float ss = float(u_supersample_i);
+        vec3 at = vec3((center + pix) / ss, dc + g_depth.y * center.x + g_depth.z * center.y);
+        vec3 lo = vec3(1e30), hi = vec3(-1e30);
+        for (int i = 0; i < m; ++i) {
+            vec3 q = vec3((s[i] + pix) / ss, dc + g_depth.y * s[i].x + g_depth.z * s[i].y);
+            lo = min(lo, q);
+            hi = max(hi, q);
+        }
+        ivec3 voxel = from_plane(ivec3(col, k), g_axis);
+        vec3 corner = vec3(voxel);
+        deposit_seen(voxel, area_px * g_area_per_px, g_normal, voxel_albedo(uv), seen,
+                     from_plane(at, g_axis) - corner, from_plane(lo, g_axis) - corner, from_plane(hi, g_axis) - corner);
     }
 }
 #endif

@@ -7,6 +7,8 @@
 //   emission rgb = Σ A·emission / Σ A
 //   with SIDES, albedo rgb is the mean over the pieces seen from the front side only (voxel/common.glsl) and a fifth
 //   volume, albedo_back, the back side's (rgb; a = the same opacity)
+//   with POSITIONS, position rgb = Σ A·(centroid − voxel min corner) / Σ A, in cells, and extent_lo / extent_hi
+//   the box the surfaces span, likewise
 // Pure integer→float arithmetic per voxel: deterministic.
 layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
 uniform ivec3 u_grid_size;
@@ -33,6 +35,14 @@ vec3 side_albedo(uvec4 acc) {
     return acc.w > 0u ? vec3(acc.rgb) * (u_albedo_max / float(acc.w)) : vec3(0.0);
 }
 #endif
+#if defined(POSITIONS)
+uniform usampler3D u_acc_position;
+// rgb: the surfaces' area-weighted centroid, in cells from the voxel's min corner (0.5: its centre where empty);
+// extent_lo / extent_hi rgb: the box the surfaces span, likewise
+layout(binding = 5, rgba32f) uniform writeonly image3D u_position;
+layout(binding = 6, rgba32f) uniform writeonly image3D u_extent_lo;
+layout(binding = 7, rgba32f) uniform writeonly image3D u_extent_hi;
+#endif
 
 uvec4 fetch(usampler3D s, ivec3 v) {
     ivec3 t = ivec3(4 * v.x, v.y, v.z);
@@ -44,6 +54,7 @@ void main() {
     ivec3 v = ivec3(gl_GlobalInvocationID);
     if (any(greaterThanEqual(v, u_grid_size))) return;
     vec4 area_m2 = vec4(0.0), albedo = vec4(0.0), normal = vec4(0.0), emission = vec4(0.0), back = vec4(0.0);
+    vec4 position = vec4(0.5, 0.5, 0.5, 0.0), extent_lo = vec4(0.0), extent_hi = vec4(1.0, 1.0, 1.0, 0.0);
     uint total = texelFetch(u_acc_area, ivec3(4 * v.x + 3, v.y, v.z), 0).r;
     if (total > 0u) {   // most voxels are empty: one fetch decides
         uvec4 area = fetch(u_acc_area, v);
@@ -57,6 +68,11 @@ void main() {
         albedo.rgb = side_albedo(fetch(u_acc_albedo, v));
         back = vec4(side_albedo(fetch(u_acc_albedo_back, v)), albedo.a);
 #endif
+#if defined(POSITIONS)
+        position.xyz = vec3(fetch(u_acc_position, v).xyz) * inv;
+        extent_lo.xyz = 1.0 - vec3(fetch(u_acc_position, v + ivec3(0, u_grid_size.y, 0)).xyz) / 65535.0;
+        extent_hi.xyz = vec3(fetch(u_acc_position, v + ivec3(0, 2 * u_grid_size.y, 0)).xyz) / 65535.0;
+#endif
     }
     imageStore(u_area, v, area_m2);
     imageStore(u_albedo, v, albedo);
@@ -64,6 +80,11 @@ void main() {
     imageStore(u_emission, v, emission);
 #if defined(SIDES)
     imageStore(u_albedo_back, v, back);
+#endif
+#if defined(POSITIONS)
+    imageStore(u_position, v, position);
+    imageStore(u_extent_lo, v, extent_lo);
+    imageStore(u_extent_hi, v, extent_hi);
 #endif
 }
 #endif
