@@ -34,6 +34,7 @@ class Clusters:
     key: np.ndarray  # (C,) block index × 6 + side (side_of) of each cluster, ascending
     offsets: np.ndarray  # (C, 2) min / max plane offset n·x (m) of its voxels' centres
     box: np.ndarray  # (C, 2, 3) min / max corner of its voxels' centres
+    extent: np.ndarray  # (C, 2, 3) min / max corner of its surfaces (lpv/gather.glsl rectangle_kernel)
     fine: Grid
     lo: np.ndarray  # the surface voxels' centres' bounding box (faces_something)
     hi: np.ndarray
@@ -67,14 +68,21 @@ def faces_something(points: np.ndarray, normals: np.ndarray, lo: np.ndarray, hi:
     return reach > h * (0.5 * np.abs(normals).sum(axis=1) + 1.0)
 
 
-def _absorb_small(piece: np.ndarray, parent: np.ndarray, smallest: int) -> np.ndarray:
+def _absorb_small(piece: np.ndarray, parent: np.ndarray, smallest: int, offset: np.ndarray | None = None,
+                  reach: float = np.inf) -> np.ndarray:
     """Pieces (labels per side) of fewer than `smallest` sides join the largest piece of their `parent` group —
-    an edge voxel whose normal leans away from its neighbours' is no surface of its own."""
+    an edge voxel whose normal leans away from its neighbours' is no surface of its own — if its plane (mean
+    `offset`) lies within `reach` of theirs: a pillar's inner face is not its outer face's, however small."""
     sizes = np.bincount(piece)
     largest = np.full(int(parent.max(initial=-1)) + 1, -1)
     by_size = np.lexsort((sizes[piece], parent))  # per parent, ascending size: the last one written wins
     largest[parent[by_size]] = piece[by_size]
-    return np.where(sizes[piece] < smallest, largest[parent], piece)
+    target = largest[parent]
+    near = True
+    if offset is not None:
+        mean = np.bincount(piece, offset) / np.maximum(sizes, 1)
+        near = np.abs(mean[piece] - mean[target]) <= reach
+    return np.where((sizes[piece] < smallest) & near, target, piece)
 
 
 def _group(key: np.ndarray, offset: np.ndarray, gap: float, pairs: np.ndarray, smallest: int) -> np.ndarray:
@@ -89,7 +97,7 @@ def _group(key: np.ndarray, offset: np.ndarray, gap: float, pairs: np.ndarray, s
     new[1:] = (k[1:] != k[:-1]) | (d[1:] - d[:-1] > gap)
     plane = np.empty(len(order), np.int64)
     plane[order] = np.cumsum(new) - 1
-    plane = _absorb_small(plane, np.unique(key, return_inverse=True)[1].reshape(-1), smallest)
+    plane = _absorb_small(plane, np.unique(key, return_inverse=True)[1].reshape(-1), smallest, offset, 2 * gap)
     a, b = pairs[plane[pairs[:, 0]] == plane[pairs[:, 1]]].T if len(pairs) else (np.zeros(0, int),) * 2
     label = np.arange(len(key))
     while True:  # connected components: each side takes the smallest label it is joined to
@@ -105,6 +113,29 @@ def _group(key: np.ndarray, offset: np.ndarray, gap: float, pairs: np.ndarray, s
     rank = np.empty(len(roots), np.int64)
     rank[np.lexsort((offset[roots], key[roots]))] = np.arange(len(roots))
     return rank[np.searchsorted(roots, label)]
+
+
+def partitioned(cells: np.ndarray, normals: np.ndarray, positions: np.ndarray, pairs: np.ndarray,
+                fine: Grid) -> np.ndarray:
+    """Per pair of neighbouring receivers (`pairs` (P, 2) indices of `cells`, unit `normals`, `positions`): whether
+    the plane of a receiver of another axis in either's voxel passes between them — a wall thinner than a voxel
+    standing on a floor that runs on under it, or meeting a wall that runs on beside it. Across it the two are
+    parts of two rooms: joined in one cluster, the lit room's light would leave from the dark room's side."""
+    nx, ny, _ = (int(n) for n in fine.size)
+    lin = (cells[:, 2].astype(np.int64) * ny + cells[:, 1]) * nx + cells[:, 0]
+    voxels, slot = np.unique(lin, return_inverse=True)
+    planes = np.full((len(voxels), 3), np.nan)  # per voxel, per axis: where its receiver of that axis lies
+    axis = np.argmax(np.abs(normals), axis=1)
+    planes[slot.reshape(-1), axis] = positions[np.arange(len(cells)), axis]
+    a, b = pairs[:, 0], pairs[:, 1]
+    tolerance = 0.1 * fine.cell
+    cut = np.zeros(len(pairs), bool)
+    for voxel in (slot.reshape(-1)[a], slot.reshape(-1)[b]):
+        q = planes[voxel]  # (P, 3)
+        da, db = positions[a] - q, positions[b] - q
+        with np.errstate(invalid="ignore"):
+            cut |= np.any((da * db < 0) & (np.abs(da) > tolerance) & (np.abs(db) > tolerance), axis=1)
+    return cut
 
 
 def neighbour_pairs(cells: np.ndarray, sides: np.ndarray, size: tuple) -> np.ndarray:
@@ -127,22 +158,28 @@ def neighbour_pairs(cells: np.ndarray, sides: np.ndarray, size: tuple) -> np.nda
 
 
 def make_clusters(cells: np.ndarray, normals: np.ndarray, areas: np.ndarray, fine: Grid, budget: int,
-                  block: int | None = None) -> Clusters:
-    """Cluster the surface voxels' sides (cells (R, 3) xyz, mean normals (R, 3), areas (R,)) into at most
+                  block: int | None = None, positions: np.ndarray | None = None,
+                  bounds: tuple | None = None) -> Clusters:
+    """Cluster the surface voxels' sides (cells (R, 3) xyz, mean normals (R, 3), areas (R,); `positions` (R, 3)
+    where their surfaces lie and `bounds` the boxes they span, else the voxels' centres and boxes) into at most
     `budget` clusters: the smallest block side S (from 2) whose blocks × sides × planes fit, or S = `block` (an
-    update after an edit keeps the blocks it had, so clusters away from the edit stay the same). Sides facing
-    nothing (`faces_something`) get none."""
+    update after an edit keeps the blocks it had, so clusters away from the edit stay the same). A cluster's VPL
+    record sits at its sides' area-weighted position; its box spans its voxels' centres and its extent their
+    surfaces. Sides facing nothing (`faces_something`) get none."""
     lengths = np.linalg.norm(normals, axis=1)
     valid = (areas > 0) & (lengths > 0)
     unit = normals / np.maximum(lengths, 1e-30)[:, None]
     centre = np.asarray(fine.origin) + (cells + 0.5) * fine.cell
     lo, hi = (centre.min(axis=0), centre.max(axis=0)) if len(centre) else (np.zeros(3), np.zeros(3))
     side_n = np.stack([unit, -unit], axis=1).reshape(-1, 3)  # voxel r's front at 2r, back at 2r + 1
-    pos = np.repeat(centre, 2, axis=0)
+    voxel = np.repeat(centre, 2, axis=0)
+    pos = voxel if positions is None else np.repeat(np.asarray(positions, np.float64), 2, axis=0)
     emits = np.repeat(valid, 2) & faces_something(pos, side_n, lo, hi, fine.cell)
     use = np.nonzero(emits)[0]
     offset = np.einsum("ij,ij->i", side_n[use], pos[use])
     pairs = neighbour_pairs(cells[use // 2], side_of(side_n[use]), fine.size)
+    if positions is not None and len(pairs):
+        pairs = pairs[~partitioned(cells, unit, np.asarray(positions, np.float64), use[pairs] // 2, fine)]
     fixed, block = block is not None, block or 2
     while True:
         key = block_keys(pos[use], side_n[use], fine, block)
@@ -169,9 +206,14 @@ def make_clusters(cells: np.ndarray, normals: np.ndarray, areas: np.ndarray, fin
     np.minimum.at(offsets[:, 0], index, offset)
     np.maximum.at(offsets[:, 1], index, offset)
     box = np.stack([np.full((count, 3), np.inf), np.full((count, 3), -np.inf)], axis=1)
-    np.minimum.at(box[:, 0], index, pos[use])
-    np.maximum.at(box[:, 1], index, pos[use])
-    return Clusters(block, sides.reshape(-1, 2), records, key[first], offsets, box, fine, lo, hi)
+    np.minimum.at(box[:, 0], index, voxel[use])
+    np.maximum.at(box[:, 1], index, voxel[use])
+    extent = np.stack([np.full((count, 3), np.inf), np.full((count, 3), -np.inf)], axis=1)
+    side_lo, side_hi = (voxel - 0.5 * fine.cell, voxel + 0.5 * fine.cell) if bounds is None else \
+        (np.repeat(np.asarray(b, np.float64), 2, axis=0) for b in bounds)
+    np.minimum.at(extent[:, 0], index, side_lo[use])
+    np.maximum.at(extent[:, 1], index, side_hi[use])
+    return Clusters(block, sides.reshape(-1, 2), records, key[first], offsets, box, extent, fine, lo, hi)
 
 
 def box_distance(points: np.ndarray, box: np.ndarray) -> np.ndarray:
@@ -180,9 +222,10 @@ def box_distance(points: np.ndarray, box: np.ndarray) -> np.ndarray:
 
 
 def own_side(clusters: Clusters, cells: np.ndarray, normals: np.ndarray, pos: np.ndarray,
-             normal: np.ndarray) -> np.ndarray:
+             normal: np.ndarray, axis: np.ndarray | None = None) -> np.ndarray:
     """Per record (positions `pos`, unit `normal`): the cluster of the side facing its way of the surface voxel it
-    lies in (`cells` (R, 3) and mean `normals` (R, 3): the voxels clusters.side_cluster numbers); −2 where that side
+    lies in (`cells` (R, 3) and mean `normals` (R, 3): the receivers clusters.side_cluster numbers; with `axis`
+    (R,), receivers per dominant axis (lpv/receivers.py), the one of the record's own axis); −2 where that side
     has none (it faces nothing: the record's light leaves the scene); −1 where the record's voxel holds no surface,
     or where that side's mean normal lies more than 60° from the record's (OWN_ALIGN): the side is mostly other
     surfaces — at a room's edge a voxel holds the ceiling's inside and the wall's outside on one side, and the
@@ -191,10 +234,12 @@ def own_side(clusters: Clusters, cells: np.ndarray, normals: np.ndarray, pos: np
     if len(cells) == 0:
         return out
     nx, ny, nz = (int(n) for n in clusters.fine.size)
-    lin = (cells[:, 2].astype(np.int64) * ny + cells[:, 1]) * nx + cells[:, 0]
+    mine = np.zeros(len(cells), np.int64) if axis is None else np.asarray(axis, np.int64)
+    lin = ((cells[:, 2].astype(np.int64) * ny + cells[:, 1]) * nx + cells[:, 0]) * 3 + mine
     order = np.argsort(lin)
     f = np.floor((pos - np.asarray(clusters.fine.origin)) / clusters.fine.cell).astype(np.int64)
-    want = (f[:, 2] * ny + f[:, 1]) * nx + f[:, 0]
+    theirs = 0 if axis is None else np.argmax(np.abs(normal), axis=1)
+    want = ((f[:, 2] * ny + f[:, 1]) * nx + f[:, 0]) * 3 + theirs
     r = order[np.minimum(np.searchsorted(lin[order], want), len(lin) - 1)]
     length = np.linalg.norm(normals[r], axis=1)
     facing = np.einsum("ij,ij->i", normals[r], normal) / np.maximum(length, 1e-30)
@@ -206,7 +251,8 @@ def own_side(clusters: Clusters, cells: np.ndarray, normals: np.ndarray, pos: np
 
 
 def bin_flux(clusters: Clusters, records: np.ndarray, cells: np.ndarray | None = None,
-             normals: np.ndarray | None = None, groups: int | None = None) -> tuple[np.ndarray, np.ndarray | float]:
+             normals: np.ndarray | None = None, groups: int | None = None,
+             axis: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray | float]:
     """The VPL records' flux (RGB) per cluster. With the clusters' voxels (`cells`, `normals`), a record goes to
     the cluster of its own voxel's side that faces its way (own_side), or leaves the scene where that side faces
     nothing: a record on the outside of a room's wall is not the inside's, however near a cluster of the room that
@@ -229,7 +275,7 @@ def bin_flux(clusters: Clusters, records: np.ndarray, cells: np.ndarray | None =
     first = np.searchsorted(clusters.key, key, "left")
     last = np.searchsorted(clusters.key, key, "right")
     faces = faces_something(pos, normal, clusters.lo, clusters.hi, near)
-    own = np.full(len(records), -1) if cells is None else own_side(clusters, cells, normals, pos, normal)
+    own = np.full(len(records), -1) if cells is None else own_side(clusters, cells, normals, pos, normal, axis)
     own[~faces] = -2  # nothing lies before it (a roof's top): its light leaves, whichever voxel side it shares
     target = np.full(len(records), -1)
     offset = np.einsum("ij,ij->i", normal, pos)

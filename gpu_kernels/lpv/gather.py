@@ -25,6 +25,7 @@ import numpy as np
 from ..common.bounce_tail import tail_ratio, tail_sum
 from ..common.grid import Grid
 from ..gl.bind import bind_grid, bind_light_records, bind_named, dispatch, set_uniform, zero_texture
+from .crossings import bind_visibility
 from .occlusion import absorb
 from .settings import LpvSettings
 from .state import LpvGridState
@@ -189,8 +190,7 @@ def gather(ctx, programs, state: LpvGridState, gv, vpls: VplList, occlusion: boo
     if vpls.count == 0:
         return
     prog = programs.compute("lpv/gather.glsl")
-    bind_named(prog, [("u_voxel_normal", gv.normal), ("u_voxel_area", gv.area), ("u_coverage", gv.coverage),
-                      ("u_layers", gv.layers)])
+    bind_visibility(prog, gv, bind_named(prog, [("u_voxel_normal", gv.normal), ("u_voxel_area", gv.area)]))
     set_uniform(prog, "u_occlusion", bool(occlusion))
     set_uniform(prog, "u_fine_origin", tuple(float(c) for c in gv.fine.origin))
     bind_grid(prog, state.grid)

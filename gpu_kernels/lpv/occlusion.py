@@ -12,6 +12,7 @@ import numpy as np
 from ..common.grid import Grid
 from ..gl.bind import bind_grid, bind_images, bind_named, dispatch, set_uniform
 from ..scene import Scene
+from .crossings import crossing_layers, volume_fields
 from .state import FIXED_RANGE, LpvGridState, resolve
 
 @dataclass
@@ -22,7 +23,7 @@ class GeometryVolume:
     area: object  # fine voxel textures from voxelize(): projected areas per axis + total area
     normal: object
     albedo: object
-    coverage: object = None  # per LPV cell (crossing_layers): its surfaces' plane(s) and covered fraction
+    coverage: object = None  # per LPV cell (lpv/crossings.py): its surfaces' plane(s) and covered fraction
     layers: object = None  # per LPV cell: where those planes lie (cells from the grid origin)
     surfaces: object = None  # storage buffer: (x, y, z, 0) int32 of every fine voxel holding a surface
     surface_count: int = 0
@@ -34,12 +35,27 @@ class GeometryVolume:
     surface_albedo: np.ndarray | None = None
     albedo_back: object = None  # the back side's albedo texture (None: `albedo` serves both sides)
     front: object = None  # the voxelisation's front-most image, kept for material edits (up to KEEP_FRONT_BYTES)
+    # Receivers per dominant axis (lpv/receivers.py, the cached transport's): each surface voxel's surfaces split
+    # by axis, so a voxel may hold up to three receivers — cells, surface_normal, surface_area and surface_albedo
+    # are then per receiver, and area / normal / albedo (the per-voxel textures) are None.
+    axis: np.ndarray | None = None  # (R,) the dominant axis of each receiver's surfaces
+    positions: np.ndarray | None = None  # (R, 3) their area-weighted centroid (m)
+    bounds: tuple | None = None  # ((R, 3), (R, 3)) the box their surfaces span (m)
+    receivers: object = None  # storage buffer: (R, 4) vec4 each receiver's mean normal and area (m²), centroid, box
+    receiver_index: object = None  # r32i fine voxel texture: 8 × first receiver + mask of its axes (receivers.py)
+
+    layers_far: object = None  # per LPV cell (lpv/crossings.py): the far layers where its surfaces form two
 
     def release(self):
         for t in (self.blocking, self.area, self.normal, self.albedo, self.coverage, self.layers, self.surfaces,
-                  self.albedo_back, self.front):
+                  self.albedo_back, self.front, self.receivers, self.receiver_index, self.layers_far):
             if t is not None:
                 t.release()
+
+
+def fine_grid(grid: Grid) -> Grid:
+    """The surface voxels of an LPV grid: half its cell, offset by half a cell, two more per axis."""
+    return Grid(tuple(np.asarray(grid.origin) - grid.cell / 2), grid.cell / 2, tuple(2 * n + 2 for n in grid.size))
 
 
 def face_blocking(area: np.ndarray, grid: Grid) -> np.ndarray:
@@ -69,61 +85,20 @@ def face_blocking(area: np.ndarray, grid: Grid) -> np.ndarray:
 # The voxelisation's front-most image (voxel/voxelize.py sides=True) is kept with a cascade's geometry volume up to
 # this size (28 MB at the default 32³), so a material edit re-voxelises the albedo without rasterising it again.
 KEEP_FRONT_BYTES = 64 * 2 ** 20
-PLANAR = 0.9  # a cell whose surfaces' normals share one plane this closely (λ_max / trace) is one oblique plane
-
-
-def crossing_layers(area: np.ndarray, normal: np.ndarray, grid: Grid) -> tuple[np.ndarray, np.ndarray]:
-    """Where each LPV cell's surfaces lie, for the gathered transport's visibility (lpv/gather.glsl): a ray that
-    crosses them inside the cell is stopped by the fraction of the cell they cover.
-
-    A cell whose surfaces are one plane (the area-weighted normal tensor Σ A·n·nᵀ has one dominant direction,
-    λ_max / trace ≥ PLANAR: a wall, a floor, a patch of a sphere) is that plane — normal n (the principal axis,
-    sign-free), offset n·x over its voxels' centres, coverage min(1, area / cell²). Otherwise (an edge or corner
-    where a floor meets a wall) it is three axis planes, one per axis a: coverage min(1, projected area / cell²)
-    at the projected-area-weighted mean coordinate. Axis planes alone would turn a sphere into a staircase that
-    rays leaving it at a grazing angle cross; one mean plane alone would put a diagonal wall across every corner.
-
-    Returns (nz, ny, nx, 4) arrays `coverage` and `layers`, in cells from the grid origin: for a plane cell
-    coverage = (n, −coverage), layers = (0, 0, 0, offset); for an axis cell coverage = (c_x, c_y, c_z, 0),
-    layers = (x̄, ȳ, z̄, 0); empty cells are zero. LPV cell c holds fine voxels [2c + 1, 2c + 3) along each axis
-    (fine voxel f's centre: (f + 0.5)/2 − 1/2 cells)."""
-    nx, ny, nz = grid.size
-    inner = (slice(1, 2 * nz + 1), slice(1, 2 * ny + 1), slice(1, 2 * nx + 1))
-    proj = area[inner][..., :3].astype(np.float64)
-    total = area[inner][..., 3].astype(np.float64)
-    n = normal[inner][..., :3].astype(np.float64)
-    n /= np.maximum(np.linalg.norm(n, axis=-1, keepdims=True), 1e-30)
-    zz, yy, xx = np.meshgrid(*[(np.arange(1, 2 * k + 1) + 0.5) / 2 - 0.5 for k in (nz, ny, nx)], indexing="ij")
-    centre = np.stack([xx, yy, zz], axis=-1)  # per fine voxel: (x, y, z) in cells
-
-    def per_cell(values):
-        return values.reshape(nz, 2, ny, 2, nx, 2, *values.shape[3:]).sum(axis=(1, 3, 5))
-    with np.errstate(invalid="ignore", divide="ignore"):
-        proj_cell = per_cell(proj)
-        axis_layer = np.nan_to_num(per_cell(proj * centre) / proj_cell)
-        area_cell = per_cell(total)
-        tensor = per_cell(total[..., None, None] * n[..., :, None] * n[..., None, :])
-        eigval, eigvec = np.linalg.eigh(tensor)  # ascending
-        planar = (area_cell > 0) & (eigval[..., 2] >= PLANAR * np.maximum(eigval.sum(axis=-1), 1e-30))
-        plane_n = eigvec[..., :, 2]
-        offset = np.nan_to_num(np.einsum("zyxi,zyxi->zyx", per_cell(total[..., None] * centre), plane_n) / area_cell)
-    coverage = np.zeros((nz, ny, nx, 4), np.float32)
-    layers = np.zeros((nz, ny, nx, 4), np.float32)
-    coverage[..., :3] = np.minimum(proj_cell / grid.cell ** 2, 1.0)
-    layers[..., :3] = axis_layer
-    cov = np.minimum(area_cell / grid.cell ** 2, 1.0)
-    coverage[planar] = np.concatenate([plane_n[planar], -cov[planar][:, None]], axis=1)
-    layers[planar] = np.concatenate([np.zeros((planar.sum(), 3)), offset[planar][:, None]], axis=1)
-    return coverage, layers
-
-
-def layer_area(area: np.ndarray, normals: np.ndarray, cell: float) -> np.ndarray:
+def layer_area(area: np.ndarray, normals: np.ndarray, cell: float, span: np.ndarray | None = None) -> np.ndarray:
     """The surface area (R,) a voxel of side `cell` presents to light, at most one layer's: the largest section of
-    the voxel across its mean normal n, cell² / max|n_i|. Two surfaces stacked within a voxel — a rug 1 mm over a
-    floor, a duplicated face — receive and reflect as one (the covered one is in its shadow); their summed area
+    the voxel across its mean normal n, cell² / max|n_i| — or, given the box its surfaces span (`span`, (R, 3) its
+    sides in m), the section of that box across n's dominant axis, so that a surface that covers part of its voxel
+    (a floor beside a wall) is bounded by the part it covers. Two surfaces stacked within a voxel — a rug 1 mm over
+    a floor, a duplicated face — receive and reflect as one (the covered one is in its shadow); their summed area
     made the LPV reflect them twice (a coplanar duplicate face 10% brighter)."""
     unit = normals / np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-30)
-    return np.minimum(area, cell * cell / np.maximum(np.abs(unit).max(axis=1), 1e-30))
+    section = np.full(len(area), cell * cell)
+    if span is not None:
+        a = np.abs(unit).argmax(axis=1)
+        rows = np.arange(len(area))
+        section = np.minimum(section, span[rows, (a + 1) % 3] * span[rows, (a + 2) % 3])
+    return np.minimum(area, section / np.maximum(np.abs(unit).max(axis=1), 1e-30))
 
 
 def geometry_volumes(ctx, programs, scene: Scene, geometry, textures, grids: list) -> list:
@@ -140,7 +115,7 @@ def geometry_volumes(ctx, programs, scene: Scene, geometry, textures, grids: lis
 
     out = []
     for grid in grids:
-        fine = Grid(tuple(np.asarray(grid.origin) - grid.cell / 2), grid.cell / 2, tuple(2 * n + 2 for n in grid.size))
+        fine = fine_grid(grid)
         keep = front_bytes(fine, 2) <= KEEP_FRONT_BYTES
         vox = voxelize(ctx, programs, scene, geometry, textures, fine, sides=True, keep_front=keep)
         arrays = vox.read()
@@ -150,10 +125,6 @@ def geometry_volumes(ctx, programs, scene: Scene, geometry, textures, grids: lis
         for t in (tex, vox.area, vox.normal, vox.albedo, vox.albedo_back):
             if t is not None:
                 t.filter = (moderngl.NEAREST, moderngl.NEAREST)
-        crossings = [ctx.texture3d(tuple(grid.size), 4, a.tobytes(), dtype="f4")
-                     for a in crossing_layers(area, arrays["normal"], grid)]
-        for t in crossings:
-            t.filter = (moderngl.NEAREST, moderngl.NEAREST)
         vox.emission.release()
         # The gather runs over this list, not the whole fine grid: a workgroup straddling a wall would leave most
         # of its SIMD lanes idle for the whole VPL loop.
@@ -161,10 +132,12 @@ def geometry_volumes(ctx, programs, scene: Scene, geometry, textures, grids: lis
         cells = np.stack([x, y, z, np.zeros_like(x)], axis=1).astype(np.int32)
         surfaces = ctx.buffer(cells.tobytes() if len(cells) else np.zeros(4, np.int32).tobytes())
         normals = arrays["normal"][z, y, x, :3]
-        out.append(GeometryVolume(tex, fine, vox.area, vox.normal, vox.albedo, *crossings, surfaces, len(cells),
-                                  cells[:, :3], normals, layer_area(area[z, y, x, 3], normals, fine.cell),
-                                  side_albedo(arrays, cells[:, :3]), albedo_back=vox.albedo_back,
-                                  front=vox.front))
+        out.append(GeometryVolume(tex, fine, vox.area, vox.normal, vox.albedo, surfaces=surfaces,
+                                  surface_count=len(cells), cells=cells[:, :3], surface_normal=normals,
+                                  surface_area=layer_area(area[z, y, x, 3], normals, fine.cell),
+                                  surface_albedo=side_albedo(arrays, cells[:, :3]), albedo_back=vox.albedo_back,
+                                  front=vox.front,
+                                  **volume_fields(ctx, crossing_layers(area, arrays["normal"], grid))))
     return out
 
 
@@ -175,18 +148,6 @@ def side_albedo(arrays: dict, cells: np.ndarray) -> np.ndarray:
     front = arrays["albedo"][z, y, x, :3]
     back = arrays["albedo_back"][z, y, x, :3] if "albedo_back" in arrays else front
     return np.stack([front, back])
-
-
-def surface_albedo(ctx, programs, scene: Scene, geometry, textures, gv: GeometryVolume) -> np.ndarray:
-    """(2, R, 3): the two sides' albedo of `gv`'s surface voxels under the scene's current materials — a
-    voxelisation of the same grid whose occupancy is discarded (a material edit changes no geometry:
-    lpv/transfer.py)."""
-    from ..voxel.voxelize import voxelize
-
-    vox = voxelize(ctx, programs, scene, geometry, textures, gv.fine, sides=True, front=gv.front)
-    arrays = vox.read(("albedo", "albedo_back"))
-    vox.release()
-    return side_albedo(arrays, gv.cells)
 
 
 def absorb(ctx, programs, state: LpvGridState, gv: GeometryVolume, add: bool) -> None:

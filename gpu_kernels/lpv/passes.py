@@ -25,7 +25,7 @@ import numpy as np
 
 from ..common.method import MethodOutput
 from ..voxel.voxelize import scene_area
-from . import clusters, gather, inject, lighting, occlusion, octree, propagate, rsm, transfer
+from . import clusters, gather, inject, lighting, occlusion, octree, propagate, receivers, rsm, transfer
 from .state import LpvGridState, cascade_grids
 
 # Outputs kept per pass (gl/pass_cache.py): the geometry's passes for two settings (the live viewport's draft and
@@ -88,9 +88,11 @@ def surface_voxels(scene, grids) -> float:
 
 
 def transfer_budget(scene, grids, s) -> int:
-    """Clusters per cascade for the cached transport, or 0 where it does not apply or would not fit `transfer_mb`
-    (T holds 2 × clusters × surface voxels float32)."""
-    if s.transport != "transfer" or not s.gathers:
+    """Clusters for the cached transport, or 0 where it does not apply or would not fit `transfer_mb` (T holds
+    2 × clusters × surface voxels float32). Not with cascades: a cascade's T would hold its own grid's clusters
+    only, and its receivers miss the light of every surface outside it (a sphere's finest cascade got 0.43 of the
+    coarse one's irradiance); the per-bounce gather draws each cascade's light from the whole scene's VPLs."""
+    if s.transport != "transfer" or not s.gathers or len(grids) > 1:
         return 0
     budget = min(s.gather_vpls, int(s.transfer_mb * 2 ** 20 / (8 * max(surface_voxels(scene, grids), 1.0))))
     return budget if budget >= transfer.MIN_CLUSTERS else 0
@@ -131,7 +133,7 @@ def _transfer(frame, grids, k_grids, maps, k_rsm, budget) -> MethodOutput:
     lights = len(frame.shadows.buffers.lights)
     units = cache.run("lpv_inject", k_src, lambda: [clusters.bin_flux(t.clusters, gather.rsm_records(
         ctx, programs, maps, frame.shadows, grid, budget, clusters.TEXEL_RECORDS, unit_color=True)[0], t.cells,
-        t.normals, groups=lights) for t, grid in zip(transfers, grids)])
+        t.normals, groups=lights, axis=t.axis) for t, grid in zip(transfers, grids)])
     colours = frame.shadows.buffers.lights["color_type"][:, :3].astype(np.float64)  # (lights, 3)
     k_prop = (k_src, frame.keys["shadow"], keys["albedo_transfer"], keys["gv"], s.max_iterations, s.clamp_negative,
               s.bounces, s.epsilon)
@@ -152,7 +154,7 @@ def _transfer_geometry(frame, grids, k_grids, budget) -> tuple:
     k_gv = (frame.keys["geometry"], k_grids, "geometry only")
 
     def volumes():
-        gvs = occlusion.geometry_volumes(ctx, programs, scene, frame.geometry, frame.textures, grids)
+        gvs = receivers.axis_volumes(ctx, programs, scene, frame.geometry, frame.textures, grids)
         for gv in gvs:
             gv.materials_key = materials  # whose albedo gv.surface_albedo holds
         return gvs
@@ -160,7 +162,7 @@ def _transfer_geometry(frame, grids, k_grids, budget) -> tuple:
     k_albedo = (k_gv, materials)
     albedo = cache.run("lpv_albedo", k_albedo, lambda: [
         gv.surface_albedo if gv.materials_key == materials else
-        occlusion.surface_albedo(ctx, programs, scene, frame.geometry, frame.textures, gv) for gv in gvs])
+        receivers.axis_albedo(ctx, programs, scene, frame.geometry, frame.textures, gv) for gv in gvs])
     k_tr = (k_gv, budget, s.occlusion)
     priors = next((value for key, value in cache.kept("lpv_transfer") if key[1:] == k_tr[1:]
                    and [t.grid for t in value] == list(grids)), [None] * len(gvs))
@@ -194,21 +196,21 @@ def _build(ctx, programs, gv, grid, budget, s, prior=None) -> transfer.Transfer:
             return transfer.sort_by_cluster(sources, matrix, gv, grid, share)
     fits = int(s.transfer_mb * 2 ** 20 / (8 * max(gv.surface_count, 1)))
     sources = clusters.make_clusters(gv.cells, gv.surface_normal, gv.surface_area, gv.fine,
-                                     max(transfer.MIN_CLUSTERS, min(budget, fits)))
+                                     max(transfer.MIN_CLUSTERS, min(budget, fits)), positions=gv.positions,
+                                     bounds=gv.bounds)
     matrix = transfer.build_transfer(ctx, programs, gv, grid, sources, s.occlusion)
     return transfer.sort_by_cluster(sources, matrix, gv, grid)
 
 
 def _solve(ctx, gvs, grids, transfers, reflection, sources, s) -> dict:
     """Each cascade's bounce series (transfer.solve), uploaded for the flux lookup, and its statistics."""
-    surfaces, stats = [], []
+    sides, stats = [], []
     for gv, grid, t, (m, gain), (first, unbinned) in zip(gvs, grids, transfers, reflection, sources):
-        sides, passes = transfer.solve(t, m, first, s.bounces, s.epsilon, gain)
-        valid = (gv.surface_area > 0) & (np.linalg.norm(gv.surface_normal, axis=1) > 0)
-        surfaces.append(transfer.upload_sides(ctx, grid, gv.fine, gv.cells, valid, sides))
+        irradiance, passes = transfer.solve(t, m, first, s.bounces, s.epsilon, gain)
+        sides.append(irradiance)
         stats.append({"cells": list(grid.size), "cell": grid.cell, "transport": "transfer",
                       "clusters": t.clusters.count, "block": t.clusters.block, "transfer_mb": t.nbytes / 2 ** 20,
                       "transfer_updated": t.updated, "injected_flux": float(first.sum()),
                       "escaped_flux": unbinned,
                       "bounces": [{"flux": f} for f in passes], "bounces_used": len(passes)})
-    return {"surfaces": surfaces, "stats": stats}
+    return {"surfaces": receivers.upload_light(ctx, grids, gvs, sides), "stats": stats}

@@ -3,11 +3,12 @@
 lpv/gather.py with its geometry-dependent part kept across light, material and world edits (the world is a light:
 common/lights.py's sky light, whose RSMs give its first bounce like any other light's).
 
-For fixed geometry the gather is linear in the light that enters it. Its sources are fixed here: the surface voxels'
-sides grouped, once per geometry, into clusters (lpv/clusters.py). The kernel of
-lpv/gather.glsl (cosines, distance, disc limit and fuzzy visibility: everything but the flux) is evaluated once per
-receiver voxel and cluster on the GPU (MODE_TRANSFER) and read back: the transfer T_s (C × R, per side s). Then an
-edit of the lights or the world costs only:
+For fixed geometry the gather is linear in the light that enters it. Its receivers are the surface voxels' surfaces
+per dominant axis, where they lie (lpv/receivers.py), and its sources their sides grouped, once per geometry, into
+clusters (lpv/clusters.py). The kernel of lpv/gather.glsl (cosines, distance, disc limit or the cluster's rectangle,
+visibility through the cells' planes: everything but the flux) is evaluated once per receiver and cluster on the GPU
+(MODE_TRANSFER) and read back: the transfer T_s (C × R, per side s). Then an edit of the lights or the world costs
+only:
 
     Φ_1        the RSM's VPL flux binned into the clusters (flux kept exactly)
     Φ_(k+1)    = M_ρ Φ_k                                              (C × C per channel: microseconds)
@@ -20,8 +21,8 @@ precomputed-radiosity factorisation of Enlighten-style systems (Martin and Einar
 architecture for video games", SIGGRAPH 2010 course), evaluated live. Every bounce is computed (no tail
 extrapolation); the series stops once a bounce adds less than `epsilon` of the largest pass's flux.
 
-Memory: T holds 2 × C × R float32 (R surface voxels); C shrinks to fit `transfer_mb`, and below MIN_CLUSTERS the
-transport falls back to the per-bounce gather (lpv/gather.py).
+Memory: T holds 2 × C × R float32 (R receivers); C shrinks to fit `transfer_mb`, and below MIN_CLUSTERS (or with
+cascades) the transport falls back to the per-bounce gather (lpv/gather.py).
 """
 from __future__ import annotations
 
@@ -30,8 +31,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..common.grid import Grid
-from ..gl.bind import bind_grid, bind_named, dispatch, set_uniform
+from ..gl.bind import bind_grid, dispatch, set_uniform
 from .clusters import Clusters
+from .crossings import bind_visibility
 from .gather import vpls_per_dispatch
 
 MIN_CLUSTERS = 64  # fewer sources than this blur a room's bounce into a few blobs: gather instead
@@ -48,8 +50,8 @@ def build_transfer(ctx, programs, gv, grid: Grid, clusters: Clusters, occlusion:
     if r == 0 or c == 0:
         return out
     prog = programs.compute("lpv/gather.glsl", {"MODE_TRANSFER": 1})
-    bind_named(prog, [("u_voxel_normal", gv.normal), ("u_voxel_area", gv.area), ("u_coverage", gv.coverage),
-                      ("u_layers", gv.layers)])
+    bind_visibility(prog, gv)
+    gv.receivers.bind_to_storage_buffer(10)
     set_uniform(prog, "u_occlusion", bool(occlusion))
     set_uniform(prog, "u_fine_origin", tuple(float(v) for v in gv.fine.origin))
     set_uniform(prog, "u_surface_count", r)
@@ -67,7 +69,7 @@ def build_transfer(ctx, programs, gv, grid: Grid, clusters: Clusters, occlusion:
     sources = ctx.buffer(records.tobytes())
     sources.bind_to_storage_buffer(6)
     boxes = np.zeros((c, 2, 4), np.float32)
-    boxes[..., :3] = clusters.box
+    boxes[..., :3] = clusters.extent
     boxes = ctx.buffer(boxes.tobytes())
     boxes.bind_to_storage_buffer(9)
     (receivers or gv.surfaces).bind_to_storage_buffer(7)
@@ -95,9 +97,9 @@ def _match(old: np.ndarray, new: np.ndarray) -> np.ndarray:
     return np.array([old_keys.get(row.tobytes(), -1) for row in new], np.int64)
 
 
-def _voxels(cells, normals, areas) -> np.ndarray:
-    """(R, 7) rows a receiver is compared by: its fine voxel, normal and area."""
-    return np.concatenate([cells.astype(np.float64), normals, areas[:, None]], axis=1)
+def _receivers(cells, axis, normals, areas) -> np.ndarray:
+    """(R, 8) rows a receiver is compared by: its fine voxel, axis, normal and area."""
+    return np.concatenate([cells.astype(np.float64), axis[:, None], normals, areas[:, None]], axis=1)
 
 
 def changed_box(moved: np.ndarray, fine: Grid, grid: Grid):
@@ -115,9 +117,10 @@ def update_transfer(ctx, programs, gv, grid: Grid, occlusion: bool, prior) -> tu
     box. Returns (clusters, matrix, the share of pairs re-evaluated)."""
     from .clusters import make_clusters
 
-    new = make_clusters(gv.cells, gv.surface_normal, gv.surface_area, gv.fine, 0, block=prior.clusters.block)
-    before, after = _voxels(prior.cells, prior.normals, prior.areas), _voxels(gv.cells, gv.surface_normal,
-                                                                              gv.surface_area)
+    new = make_clusters(gv.cells, gv.surface_normal, gv.surface_area, gv.fine, 0, block=prior.clusters.block,
+                        positions=gv.positions, bounds=gv.bounds)
+    before = _receivers(prior.cells, prior.axis, prior.normals, prior.areas)
+    after = _receivers(gv.cells, gv.axis, gv.surface_normal, gv.surface_area)
     old_r = _match(before, after)
     old_c = _match(prior.clusters.records, new.records)
     gone = _match(after, before) < 0
@@ -146,7 +149,8 @@ class Transfer:
     order: list  # per side: (R,) receiver index of each column
     starts: list  # per side: (C + 1,) first column of each cluster; columns past starts[s][-1] have none
     grid: Grid = None
-    cells: np.ndarray = None  # (R, 3) the receivers' fine voxels, their normals and areas
+    cells: np.ndarray = None  # (R, 3) the receivers' fine voxels, axes (lpv/receivers.py), normals and areas
+    axis: np.ndarray = None
     normals: np.ndarray = None
     areas: np.ndarray = None
     updated: float = 1.0  # the share of T evaluated when it was made (1: all of it; less after an edit)
@@ -170,7 +174,7 @@ def sort_by_cluster(clusters: Clusters, matrix: np.ndarray, gv=None, grid: Grid 
         starts.append(np.searchsorted(key[perm], np.arange(clusters.count + 1)))
     if gv is None:
         return Transfer(clusters, out, order, starts, updated=updated)
-    return Transfer(clusters, out, order, starts, grid, gv.cells.copy(), gv.surface_normal.copy(),
+    return Transfer(clusters, out, order, starts, grid, gv.cells.copy(), gv.axis.copy(), gv.surface_normal.copy(),
                     gv.surface_area.copy(), updated)
 
 
@@ -255,42 +259,3 @@ def solve(t: Transfer, m_rho: np.ndarray, first: np.ndarray, bounces: int, epsil
     for side in range(2):
         out[side, t.order[side]] = (sums @ t.matrix[side]).T
     return out, passes
-
-
-def read_sides(state, cells: np.ndarray) -> np.ndarray:
-    """(2, R, 3): the front / back irradiance textures of `state` (fine voxels) at `cells` (R, 3) xyz."""
-    out = []
-    for tex in (state.front, state.back):
-        w, h, d = tex.size
-        data = np.frombuffer(tex.read(), np.float32).reshape(d, h, w, 4)
-        out.append(data[cells[:, 2], cells[:, 1], cells[:, 0], :3])
-    return np.stack(out)
-
-
-@dataclass
-class SurfaceIrradiance:
-    """What the flux lookup (lpv/lighting.glsl) reads of one cascade: irradiance per fine voxel and side."""
-    grid: Grid
-    front_total: object
-    back_total: object
-
-    def release(self):
-        self.front_total.release()
-        self.back_total.release()
-
-
-def upload_sides(ctx, grid: Grid, fine: Grid, cells: np.ndarray, valid: np.ndarray,
-                 sides: np.ndarray) -> SurfaceIrradiance:
-    """Fine-voxel textures of (2, R, 3) irradiance at `cells`; a = 1 on voxels that receive (`valid`)."""
-    import moderngl
-
-    nx, ny, nz = fine.size
-    textures = []
-    for side in range(2):
-        data = np.zeros((nz, ny, nx, 4), np.float32)
-        data[cells[:, 2], cells[:, 1], cells[:, 0], :3] = np.where(valid[:, None], sides[side], 0.0)
-        data[cells[:, 2], cells[:, 1], cells[:, 0], 3] = valid
-        tex = ctx.texture3d((nx, ny, nz), 4, data.tobytes(), dtype="f4")
-        tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
-        textures.append(tex)
-    return SurfaceIrradiance(grid, *textures)

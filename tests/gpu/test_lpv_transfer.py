@@ -126,15 +126,18 @@ def test_moving_an_object_updates_the_transfer_and_matches_a_render_from_scratch
     _same(_indirect(moved), _indirect(cold))
 
 
-def test_receivers_beside_an_edge_get_the_closed_box_irradiance():
+def test_receivers_beside_and_on_an_edge_get_the_closed_box_irradiance():
     """A closed 2 m box whose every cluster sends its area's worth of flux (a uniform radiosity B = 1 W/m²): every
     receiver inside should get irradiance B — half of it, beside an edge, from the adjacent wall right next to it.
-    The kernel stands a cluster in for a rectangle of uniform radiance where the receiver is in its near field
-    (lpv/gather.glsl rectangle_kernel). Measured at 16³ (area means of T · Φ over the receivers' lit side): 0.954
-    of B half to one LPV cell from an edge, 0.978 one to two cells, 0.994 four or more; with the quarter discs
-    before, 0.912 and 0.972 (0.88 and 0.94 at 32³). Bounds: 0.94 and 0.965, about 1.5 points under the
-    measurement (the kernel is deterministic; the margin is for other drivers' float rounding). (The voxels on an edge or a corner hold
-    two walls under one mean normal and get 0.74 / 0.51: docs/stress.md.)"""
+
+    Near a cluster in an axis plane the kernel integrates the rectangle its surfaces span (lpv/gather.glsl
+    rectangle_kernel); the receivers are a voxel's surfaces per dominant axis, where they lie (lpv/receivers.py), so
+    the voxels on an edge or in a corner hold one receiver per wall, each beside the others. Measured at 16³ (area
+    means of T · Φ over the receivers' lit side): 0.997 of B half to one LPV cell from an edge, 0.996 one to two
+    cells, 0.998 four or more; the receivers sharing an edge or corner voxel 0.98–0.99. Before the receivers per
+    axis: 0.954 / 0.978 / 0.994, and the edge / corner voxels, one receiver under the walls' mean normal, 0.49 /
+    0.23 (8³ and 32³ alike; the quarter discs before the rectangles: 0.912, 0.972). Bounds: 0.97 — the kernel is
+    deterministic; 1–2 points is other drivers' float rounding, and a lost wall shows as half."""
     from support.stress import furnace, settings
 
     engine = Engine()
@@ -148,14 +151,58 @@ def test_receivers_beside_an_edge_get_the_closed_box_irradiance():
     centre = np.asarray(t.clusters.fine.origin) + (t.cells + 0.5) * t.clusters.fine.cell
     on_wall = np.abs(np.abs(centre) - 1.0) < t.clusters.fine.cell
     from_edge = np.where(on_wall, np.inf, 1.0 - np.abs(centre)).min(axis=1) / t.grid.cell
-    face = on_wall.sum(axis=1) == 1
+    _, voxel, shared = np.unique(t.cells, axis=0, return_inverse=True, return_counts=True)
+    alone = shared[voxel.reshape(-1)] == 1
 
-    def mean(lo, hi):
-        m = face & (from_edge >= lo) & (from_edge < hi)
+    def mean(m):
         return float((e[m] * areas[m]).sum() / areas[m].sum())
-    near, next_ = mean(0.5, 1.0), mean(1.0, 2.0)
-    print(f"closed box, B = 1: {near:.3f} (½–1 cell from an edge), {next_:.3f} (1–2), {mean(4.0, 99.0):.3f} (≥ 4)")
-    assert 0.94 <= near <= 1.02 and 0.965 <= next_ <= 1.02
+    near, next_, far = (mean(alone & (from_edge >= lo) & (from_edge < hi)) for lo, hi in ((0.5, 1), (1, 2), (4, 99)))
+    edge, corner = mean(shared[voxel.reshape(-1)] == 2), mean(shared[voxel.reshape(-1)] == 3)
+    print(f"closed box, B = 1: {near:.3f} (½–1 cell from an edge), {next_:.3f} (1–2), {far:.3f} (≥ 4); "
+          f"in an edge voxel {edge:.3f}, a corner voxel {corner:.3f}")
+    for value in (near, next_, far, edge, corner):
+        assert 0.97 <= value <= 1.02
+
+
+def _two_rooms(inner, light_at=(-1.0, 0.0, 1.0)):
+    """A closed 4 × 2 × 2 m room holding `inner` (quads facing out), a 100 W point light at `light_at`, white."""
+    quads = box_quads((-2, -1, 0), (2, 1, 2), 0) + inner
+    bulb = np.eye(4)
+    bulb[:3, 3] = light_at
+    return quads, [Material("white", (0.7, 0.7, 0.7))], [Light("bulb", "POINT", (1, 1, 1), 100.0, bulb)]
+
+
+def test_a_wall_thinner_than_a_voxel_keeps_the_next_room_dark():
+    """Two rooms parted by a 2 cm slab from floor to ceiling (a tenth of a fine voxel at 32³), floor, ceiling and
+    side walls running on past it, the light in the left one: the right room gets no light (Cycles: none). The side
+    walls' voxels beside the slab hold both rooms' surfaces; joined into one cluster across it the lit room's light
+    left from the dark room's side (lpv/clusters.partitioned cuts them apart). Measured: the dark room's mean Diffuse
+    Indirect 0.49% of the lit room's (2.15% before); bound 0.7%."""
+    quads, mats, lights = _two_rooms(box_quads((-0.01, -1, 0), (0.01, 1, 2), 0, inward=False))
+    means = []
+    for eye in ((-1.9, 0.0, 1.0), (1.9, 0.0, 1.0)):
+        r = Engine().render(quad_scene(quads, mats, lights, eye, (0.0, 0.0, 0.8), lens=12.0),
+                            RenderSettings("lpv", 64, 48, lpv=LpvSettings(resolution=32, bounces=3)))
+        means.append(float(r.passes["Diffuse Indirect"][..., 0].mean()))
+    print(f"slab: lit room {means[0]:.4f}, dark room {means[1]:.5f} ({means[1] / means[0]:.3%})")
+    assert means[0] > 0 and means[1] < 0.007 * means[0]
+
+
+def test_light_inside_a_pillar_thinner_than_a_cell_stays_mostly_inside():
+    """A closed 0.3 m pillar from floor to ceiling (thinner than the 0.31 m LPV cell at 16³) with the light inside
+    it: the room outside gets no light (Cycles: none). Both faces of the pillar fall in one cell; as one mean plane
+    between them, light crossed the face it left by and the one it arrived at within half a cell of either end, and
+    went through. As two layers (lpv/crossings.py) each face stops it. Measured: the room's mean Diffuse Indirect
+    0.14 of what the same light gives outside the pillar (0.38 before); bound 0.17 — the rest still leaks where a
+    floor voxel holds the floor on both sides of a face, one receiver just outside."""
+    means = []
+    for x in (0.0, 1.0):
+        quads, mats, lights = _two_rooms(box_quads((-0.15, -0.15, 0.0), (0.15, 0.15, 2.0), 0, inward=True), (x, 0, 1))
+        r = Engine().render(quad_scene(quads, mats, lights, (1.9, 0.9, 1.5), (0.0, 0.0, 0.8), lens=14.0),
+                            RenderSettings("lpv", 64, 48, lpv=LpvSettings(resolution=16, bounces=3)))
+        means.append(float(r.passes["Diffuse Indirect"][..., 0].mean()))
+    print(f"pillar: light inside {means[0]:.4f}, outside {means[1]:.4f} ({means[0] / means[1]:.3f})")
+    assert means[1] > 0 and means[0] < 0.17 * means[1]
 
 
 def test_the_first_bounce_is_linear_in_the_lights():

@@ -81,9 +81,13 @@ def compare(ours: dict, ref) -> dict:
                            ref.passes["Diffuse Direct"] + ref.passes["Diffuse Indirect"])
     else:
         out[DERIVED] = 1.0
+    # Diffuse Indirect's mean over the compared pixels, ours / Cycles': too bright (> 1) or too dark, at a glance.
+    di_ref = float(ref.passes["Diffuse Indirect"][mask].sum())
+    di_ratio = float(ours["Diffuse Indirect"][..., :3][mask].sum()) / di_ref if di_ref > 0 else None
     diff = np.abs(ours["Diffuse Color"][..., :3] - ref.passes["Diffuse Color"]).max(axis=-1)
     match = float(np.mean(diff[mask] <= MATCH_TOLERANCE)) if mask.any() else float("nan")
-    return {"rel_l1": out, MATCH: round(match, 6), "missing": missing, "zero": zero, "pixels": int(mask.sum())}
+    return {"rel_l1": out, MATCH: round(match, 6), "missing": missing, "zero": zero, "pixels": int(mask.sum()),
+            "di_ratio": None if di_ratio is None else round(di_ratio, 4)}
 
 
 def measure(names, methods, directory=None, lpv_pairs=(), vct_pairs=()) -> dict:
@@ -178,7 +182,7 @@ def _cell(v, target=None) -> str:
 def format_table(data: dict, methods=METHODS) -> str:
     """Markdown: a row per scene x method (✗: the issue's target missed) and a row of the reference's noise floors."""
     passes = table_passes()
-    head = ["scene", "method", *passes, MATCH, "s"]
+    head = ["scene", "method", *passes, MATCH, "DI / Cycles", "s"]
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for name, row in data.items():
         for m in methods:
@@ -188,10 +192,11 @@ def format_table(data: dict, methods=METHODS) -> str:
             cells = [_cell(r["rel_l1"].get(p), TARGETS.get(p)) for p in passes]
             match = r[MATCH]
             cells.append(f"{match:.1%}" + (" ✗" if match < MATCH_TARGET else ""))
+            cells.append("—" if r.get("di_ratio") is None else f"{r['di_ratio']:.2f}")
             lines.append(f"| {name} | {m} | " + " | ".join(cells) + f" | {r['seconds']:.1f} |")
         floors = [_cell(row["noise_floor"].get(p)) for p in passes]
         lines.append(f"| {name} | *noise floor* ({row['samples']} spp) | " + " | ".join(floors)
-                     + f" | {row['diffuse_color_unstable']:.1%} unstable | |")
+                     + f" | {row['diffuse_color_unstable']:.1%} unstable | | |")
     missing = sorted({p for row in data.values() for m in methods if m in row for p in row[m]["missing"]})
     notes = ["", "rel-L1 over the pixels that hit geometry in both renders; — : Cycles' pass is 0 there; "
              f"✗ : the issue's target missed (Combined ≤ 0.08, Diffuse Indirect ≤ 0.15, Diffuse Direct ≤ 0.02, "

@@ -34,8 +34,9 @@ uniform int u_vpl_first;           // this dispatch's VPLs: [first, first + coun
 uniform int u_vpl_count;
 uniform sampler3D u_voxel_normal;   // fine voxels: mean sign-canonical normal
 uniform sampler3D u_voxel_area;     // fine voxels: rgb projected areas, a = surface area (m²)
-uniform sampler3D u_coverage;       // LPV cells: covered fraction of the x/y/z cross-sections (lpv/occlusion.py)
-uniform sampler3D u_layers;         // LPV cells: where those surfaces lie along x/y/z, in cells
+uniform sampler3D u_coverage;       // LPV cells (lpv/crossings.py): their surfaces' plane(s) and covered fraction,
+uniform sampler3D u_layers;         //   where those planes lie (cells), how near an end a crossing is its own,
+uniform sampler3D u_layers_far;     //   and where a second layer lies, if any (packed: crossings._pack)
 uniform bool u_occlusion;
 uniform vec3 u_fine_origin;
 uniform vec3 u_grid_origin;
@@ -43,12 +44,15 @@ uniform float u_grid_cell;
 uniform ivec3 u_grid_size;
 #if defined(MODE_TRANSFER)
 layout(std430, binding = 8) writeonly buffer Transfer { vec2 transfer[]; };  // lpv/transfer.py
+// The receivers (lpv/receivers.py): a voxel's surfaces of one dominant axis each, surfaces[i] its voxel and
+// receivers[2i] its mean normal (xyz) and area (w), receivers[2i + 1] its surfaces' centroid.
+layout(std430, binding = 10) readonly buffer Receivers { vec4 receivers[]; };
 // An update after an edit (lpv/transfer.update_transfer): only pairs whose receiver or source is new (w / flux.w
 // set) or whose ray passes through the changed box are evaluated; the others are marked NaN and keep their value.
 uniform bool u_update;
 uniform vec3 u_box_lo;
 uniform vec3 u_box_hi;
-// Per source: the min / max corner of its voxels' centres (lpv/clusters.Clusters.box), w unused.
+// Per source: the min / max corner of its surfaces (lpv/clusters.Clusters.extent), w unused.
 layout(std430, binding = 9) readonly buffer SourceBoxes { vec4 source_boxes[]; };
 
 bool crosses_box(vec3 a, vec3 b) {  // the segment a → b meets the box (slab test)
@@ -67,23 +71,72 @@ layout(rgba32f, binding = 3) uniform image3D u_back_total;
 #endif
 
 const float PI = 3.14159265358979;
-const float END_CELLS = 0.5;
+
 
 vec3 step01(vec3 d) {
     return vec3(greaterThan(d, vec3(0.0)));
 }
+const float OWN_PLANE = 0.1;  // MODE_TRANSFER: a receiver this near a source's plane (in fine voxels) lies in it
 const float NEAR_FIELD = 9.0;  // (distance / disc radius)² below which a VPL is split in four
+const float RECTANGLE_FIELD = 36.0;  // MODE_TRANSFER: within 6 disc radii, an axis-plane cluster as its rectangle
+const float LAYER_END = 0.05;  // lpv/crossings.END_SLACK: a layer where its surfaces lie
 const float AXIS_PLANE = 0.985;  // a source whose normal is within 10° of an axis lies in that axis' plane
 
-// Visibility between a VPL at `from` and a receiver `dist` away along unit `dir`: the ray walks the LPV cells it passes
+// Which of the three axis planes' crossings at parameters tc lie in the box cell c's surfaces span, given as
+// lpv/crossings.box_code (0: the whole cell); c, o, dir in cells. An axis plane covers its cell only there.
+float in_span(vec3 q, vec3 lo, vec3 hi, vec3 along) {  // inside along the axes `along` selects
+    vec3 outside = (vec3(lessThan(q, lo - 1e-3)) + vec3(greaterThan(q, hi + 1e-3))) * along;
+    return float(all(equal(outside, vec3(0.0))));
+}
+vec3 in_box(float code, ivec3 c, vec3 o, vec3 dir, vec3 tc) {
+    if (code < 1.0) return vec3(1.0);
+    uint p = uint(code) - 1u;
+    vec3 lo = vec3(c) + vec3(uvec3(p, p >> 4, p >> 8) & 15u) / 16.0;
+    vec3 hi = vec3(c) + (vec3(uvec3(p >> 12, p >> 16, p >> 20) & 15u) + 1.0) / 16.0;
+    return vec3(in_span(o + tc.x * dir, lo, hi, vec3(0, 1, 1)), in_span(o + tc.y * dir, lo, hi, vec3(1, 0, 1)),
+                in_span(o + tc.z * dir, lo, hi, vec3(1, 1, 0)));  // no loop: see vpls_per_dispatch
+}
+
+// The crossings the ray o + s·dir, s in [t, t_exit) (span = (t, t_exit, len)), makes with planes along unit `n` at
+// offsets `layer` (near, far) covering `coverage` — those beyond `ends` (source's, receiver's) of either end along
+// n — summed.
+float crossings_of(vec3 o, vec3 dir, vec3 span, vec3 n, vec2 layer, vec2 ends, vec2 coverage) {
+    float facing = dot(n, dir);
+    vec2 tc = (layer - dot(n, o)) / (facing != 0.0 ? facing : 1e-30);
+    vec2 hit = vec2(greaterThanEqual(tc, vec2(span.x))) * vec2(lessThan(tc, vec2(span.y)))
+             * vec2(greaterThan(abs(tc * facing), vec2(ends.x)))
+             * vec2(greaterThan(abs((span.z - tc) * facing), vec2(ends.y)));
+    return dot(coverage, hit);
+}
+
+// The same for the three axis planes at once, each with its own ends (no loop: see vpls_per_dispatch).
+float axis_crossings(ivec3 c, vec3 o, vec3 dir, vec3 inv, vec3 span, vec3 layer, vec3 end_from, vec3 end_to,
+                     vec4 coverage) {
+    vec3 tc = (layer - o) * inv;  // where the ray meets each plane
+    vec3 hit = vec3(greaterThanEqual(tc, vec3(span.x))) * vec3(lessThan(tc, vec3(span.y)))
+             * vec3(greaterThan(abs(tc * dir), end_from)) * vec3(greaterThan(abs((span.z - tc) * dir), end_to));
+    if (all(equal(hit, vec3(0.0)))) return 0.0;
+    return dot(coverage.xyz, hit * in_box(coverage.w, c, o, dir, tc));
+}
+
+// A plane along n is an end's own only if that end's surface (normal `own`) lies along it too — within 60°: a floor
+// beside a wall is not the wall, however near it.
+#define OWN_FACING 0.5
+float own_end(vec3 n, vec3 own, float end) {  // end > 1: where the surfaces lie is known (lpv/crossings._pack)
+    return end <= 1.0 ? end : abs(dot(n, own)) >= OWN_FACING ? end - 1.0 : LAYER_END;
+}
+vec3 own_ends(vec3 own, vec3 end) {
+    return mix(vec3(LAYER_END), end, vec3(greaterThanEqual(abs(own), vec3(OWN_FACING))));
+}
+
+// Visibility between a VPL at `from` (normal n_from) and a receiver (normal n_to) `dist` away along unit `dir`: the ray walks the LPV cells it passes
 // (the traversal of Amanatides and Woo 1987) and, in each, meets the cell's surfaces only if it crosses the plane where
-// they lie inside the cell — one oblique plane, or one per axis where a floor meets a wall (u_coverage, u_layers:
-// lpv/occlusion.crossing_layers) — then their covered fraction of the light is stopped, as the geometry volume stops it
-// at a face in propagation. A ray passing a wall without crossing it is not dimmed (a trilinear density would, within a
-// cell of every wall and corner). Crossings within END_CELLS along an axis of either end (along the plane's normal)
-// belong to the VPL's or the receiver's own surface (the planes are the voxels' centres, off the surface by up to a
-// quarter cell) and are not counted.
-float transmittance(vec3 from, vec3 dir, float dist) {
+// they lie inside the cell, inside the box they span — one oblique plane, or one per axis where a floor meets a wall,
+// each one layer or two (a pillar's faces; lpv/crossings.py) — then their covered fraction of the light is stopped,
+// as the geometry volume stops it at a face in propagation. A ray passing a wall without crossing it is not dimmed (a
+// trilinear density would, within a cell of every wall and corner). A crossing near enough an end along a plane facing
+// the way that end's surface does (lpv/crossings.py: the layers' ends) is that end's own surface and is not counted.
+float transmittance(vec3 from, vec3 n_from, vec3 dir, float dist, vec3 n_to) {
     if (!u_occlusion) return 1.0;
     vec3 o = (from - u_grid_origin) / u_grid_cell;  // in cells
     float len = dist / u_grid_cell;
@@ -99,17 +152,21 @@ float transmittance(vec3 from, vec3 dir, float dist) {
         float t_exit = min(t_max.x, min(t_max.y, t_max.z));
         if (all(greaterThanEqual(c, ivec3(0))) && all(lessThan(c, u_grid_size))) {
             vec4 coverage = texelFetch(u_coverage, c, 0);
-            if (coverage.w < 0.0) {  // one plane: normal coverage.xyz, offset layers.w, covering −coverage.w
-                float facing = dot(coverage.xyz, dir);
-                float tc = (texelFetch(u_layers, c, 0).w - dot(coverage.xyz, o)) / (facing != 0.0 ? facing : 1e-30);
-                if (tc >= t && tc < t_exit && abs(tc * facing) > END_CELLS && abs((len - tc) * facing) > END_CELLS)
-                    crossings -= coverage.w;
-            } else if (any(greaterThan(coverage.xyz, vec3(0.0)))) {  // axis planes
-                vec3 tc = (texelFetch(u_layers, c, 0).xyz - o) * inv;  // where the ray meets each plane
-                vec3 hit = vec3(greaterThanEqual(tc, vec3(t))) * vec3(lessThan(tc, vec3(t_exit)))
-                         * vec3(greaterThan(abs(tc * dir), vec3(END_CELLS)))
-                         * vec3(greaterThan(abs((len - tc) * dir), vec3(END_CELLS)));  // no loop: see vpls_per_dispatch
-                crossings += dot(coverage.xyz, hit);
+            vec3 span = vec3(t, min(t_exit, len), len);  // the segment ends at the receiver
+            if (coverage.w < 0.0) {  // one plane: normal coverage.xyz covering −coverage.w, layers (far, end, far's, near)
+                vec4 l = texelFetch(u_layers, c, 0);  // end < 0: a second layer
+                vec2 ends = vec2(own_end(coverage.xyz, n_from, abs(l.y)), own_end(coverage.xyz, n_to, abs(l.y)));
+                crossings += crossings_of(o, dir, span, coverage.xyz, l.wx, ends, vec2(-coverage.w, l.y < 0.0 ? l.z : 0.0));
+            } else if (any(greaterThan(coverage.xyz, vec3(0.0)))) {  // axis planes: layers (near x, y, z, end)
+                vec4 l = texelFetch(u_layers, c, 0);  // end < 0: a second layer along some axis, at layers_far
+                vec3 far = l.w < 0.0 ? texelFetch(u_layers_far, c, 0).xyz : l.xyz;
+                vec3 two = vec3(notEqual(far, l.xyz));  // the far layer equals the near one along the other axes
+                bool planes = abs(l.w) > 1.0;  // meeting planes (a floor and a wall), not a curve: lpv/crossings._pack
+                vec3 end = mix(vec3(planes ? abs(l.w) - 1.0 : abs(l.w)), vec3(LAYER_END), two);
+                vec3 end_from = planes ? own_ends(n_from, end) : end, end_to = planes ? own_ends(n_to, end) : end;
+                crossings += axis_crossings(c, o, dir, inv, span, l.xyz, end_from, end_to, coverage)
+                           + (l.w < 0.0 ? axis_crossings(c, o, dir, inv, span, far, end_from, end_to,
+                                                         vec4(coverage.xyz * two, coverage.w)) : 0.0);
             }
             if (crossings >= 1.0) return 0.0;
         }
@@ -134,7 +191,7 @@ bool rectangle_kernel(int j, Vpl v, vec3 p, vec3 nv, float h, out vec2 k) {
     vec3 ea = a.x >= a.y ? (a.x >= a.z ? vec3(1, 0, 0) : vec3(0, 0, 1)) : (a.y >= a.z ? vec3(0, 1, 0) : vec3(0, 0, 1));
     if (dot(a, ea) < AXIS_PLANE * length(v.normal.xyz)) return false;
     vec3 eb = ea.zxy, ec = ea.yzx;  // the plane's two axes
-    vec3 lo = source_boxes[2 * j].xyz - 0.5 * h - p, hi = source_boxes[2 * j + 1].xyz + 0.5 * h - p;  // voxels' extent
+    vec3 lo = source_boxes[2 * j].xyz - p, hi = source_boxes[2 * j + 1].xyz - p;  // its surfaces' extent
     vec3 base = ea * (v.position.xyz - p);  // corners relative to the receiver, in order around the rectangle
     vec3 q0 = base + eb * lo + ec * lo, q1 = base + eb * hi + ec * lo;
     vec3 q2 = base + eb * hi + ec * hi, q3 = base + eb * lo + ec * hi;
@@ -149,6 +206,7 @@ bool rectangle_kernel(int j, Vpl v, vec3 p, vec3 nv, float h, out vec2 k) {
 }
 #endif
 
+
 // What VPL j (v) of unit flux gives a receiver voxel at p (normal nv) per side: (front, back) irradiance per watt,
 // so that E = Φ · kernel. Linear in Φ: the transfer (MODE_TRANSFER) stores it per receiver and source.
 vec2 vpl_kernel(int j, Vpl v, vec3 p, vec3 nv, float h) {
@@ -159,22 +217,31 @@ vec2 vpl_kernel(int j, Vpl v, vec3 p, vec3 nv, float h) {
     // its centre is off the surface by up to half a voxel, which would light the back of a surface with its
     // own front (a roof's underside with its sunlit top): skip it too.
     float height = dot(nl, d);
+#if defined(MODE_TRANSFER)
+    // Receivers and clusters sit where their surfaces lie (lpv/receivers.py), so a receiver across the source's
+    // plane (a floor beside a wall) is lit from OWN_PLANE of a fine voxel above it — but one facing the source's way
+    // (a neighbouring patch of a sphere, a slab's far face merged into one voxel with its near one) still lies in the
+    // source's own surface within the old half voxel, scaled by how parallel the two are: without that, a metal
+    // sphere's patches lit each other (metals' Diffuse Indirect 1.16× Cycles').
+    if (height < h * max(OWN_PLANE, 0.5 * dot(abs(nl), vec3(1.0)) * abs(dot(nl, nv)))) return vec2(0.0);
+#else
     if (height < 0.5 * h * dot(abs(nl), vec3(1.0))) return vec2(0.0);
+#endif
     float d2 = dot(d, d);
     float dist = sqrt(d2);
     vec3 w = d / dist;
     float receive = dot(nv, -w);  // > 0: the VPL is on the voxel's front side (as in lpv/absorb.glsl)
     float source_area = max(PI * h * h, v.normal.w);
-    float t = transmittance(v.position.xyz, w, dist);
+    float t = transmittance(v.position.xyz, nl, w, dist, nv);
     if (t <= 0.0) return vec2(0.0);
+#if defined(MODE_TRANSFER)
+    vec2 exact;
+    if (d2 <= RECTANGLE_FIELD * source_area / PI && rectangle_kernel(j, v, p, nv, h, exact)) return exact * t;
+#endif
     if (d2 > NEAR_FIELD * source_area / PI) {
         float e = height / dist * abs(receive) * t / (PI * d2 + source_area);
         return receive > 0.0 ? vec2(e, 0.0) : vec2(0.0, e);
     }
-#if defined(MODE_TRANSFER)
-    vec2 exact;
-    if (rectangle_kernel(j, v, p, nv, h, exact)) return exact * t;
-#endif
     // Near a cluster (within 3 of its disc radii) its centroid is a poor stand-in — at a corner the
     // centroid sits level with a receiver its nearer part faces: four quarter discs, at their centroids
     // (0.6 radii out along the diagonals), each with a quarter of the flux and area. Visibility: the centroid's.
@@ -196,19 +263,30 @@ vec2 vpl_kernel(int j, Vpl v, vec3 p, vec3 nv, float h) {
 void main() {
     if (int(gl_GlobalInvocationID.x) >= u_surface_count) return;
     ivec3 f = surfaces[gl_GlobalInvocationID.x].xyz;
+#if defined(MODE_TRANSFER)
+    int i = int(gl_GlobalInvocationID.x);
+    vec4 oriented = receivers[2 * i];  // one of the voxel's receivers (lpv/receivers.py)
+    vec3 nv = oriented.xyz;
+    bool receives = oriented.w > 0.0 && dot(nv, nv) > 0.0;
+    vec3 p = receivers[2 * i + 1].xyz;
+#else
     vec4 area = texelFetch(u_voxel_area, f, 0);
     vec3 nv = texelFetch(u_voxel_normal, f, 0).xyz;
     bool receives = area.a > 0.0 && dot(nv, nv) > 0.0;
+#endif
     nv = receives ? normalize(nv) : vec3(0.0, 0.0, 1.0);
     float h = 0.5 * u_grid_cell;
+#if !defined(MODE_TRANSFER)
     vec3 p = u_fine_origin + (vec3(f) + 0.5) * h;
+#endif
 #if defined(MODE_TRANSFER)
     // One row per source of this dispatch: transfer[(j − first) · surfaces + receiver] = (front, back).
     bool fresh_receiver = !u_update || surfaces[gl_GlobalInvocationID.x].w != 0;
     for (int j = u_vpl_first; j < u_vpl_first + u_vpl_count; ++j) {
         bool fresh = fresh_receiver || vpls[j].flux.w != 0.0 || crosses_box(vpls[j].position.xyz, p);
         transfer[(j - u_vpl_first) * u_surface_count + int(gl_GlobalInvocationID.x)] =
-            !fresh ? vec2(uintBitsToFloat(0x7fc00000u)) : receives ? vpl_kernel(j, vpls[j], p, nv, h) : vec2(0.0);
+            !fresh ? vec2(uintBitsToFloat(0x7fc00000u)) :
+            receives ? vpl_kernel(j, vpls[j], p, nv, h) : vec2(0.0);
     }
 #else
     if (!receives) return;
