@@ -18,8 +18,9 @@ METHODS = ("none", "lpv", "vct")
 # GPU memory a method's volumes take: bytes per voxel plus a fixed part, every texture and buffer a render allocates
 # included (tallied over renders at 16³–48³: VCT 912 B of 3D textures + ≤ 25 B of buffers per voxel of its padded
 # grid; LPV ≤ 1976 B of 3D textures (its geometry volume at twice the resolution included) + 170–320 B of buffers per
-# cell of each cascade, and ≈ 4 MB of VPL buffers at any size). tests/stress/test_grids_bounces.py holds these to a
-# tally of the allocations, so a volume added but not counted here fails a test. VCT's injection adds its cover
+# cell of each cascade, and ≈ 4 MB of VPL buffers at any size; the LPV's three voxelisations per axis
+# (lpv/receivers.py) are held one at a time). tests/stress/test_grids_bounces.py holds these to the peak of what a
+# render holds at once, so a volume added but not counted here fails a test. VCT's injection adds its cover
 # test's front-most images (vct/inject.front_bytes, sized by the grid's largest side).
 VCT_BYTES_PER_VOXEL, VCT_FIXED_BYTES = 940, 2 ** 20
 LPV_BYTES_PER_CELL, LPV_FIXED_BYTES = 2300, 8 * 2 ** 20
