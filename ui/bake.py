@@ -7,12 +7,13 @@ INDIRECT, colour off, into a point attribute — optionally plus the direct ligh
 
 How a vertex is evaluated. Cycles bakes a point attribute at every face corner, exactly at the vertex, and averages
 the corners of each vertex. A voxel method cannot resolve light closer to a surface than about one cell: at a room's
-corner the cell that holds the vertex also holds the neighbouring wall, and it sees into it (evaluated exactly at the
-vertices the Cornell box's bake is 0.39-0.42 rel-L1 from Cycles', far too dark). So each corner is evaluated at the
-vertex moved INSET_CELLS cells of the method's grid (1.2 for LPV, 1.0 for VCT) toward its face's centre (at most
-INSET_LIMIT of the way there, so a small face keeps its sample inside), with the corner's normal, and the corners are
-averaged per vertex, as Cycles does. Method "none" has no grid and is evaluated at the vertices. The measured errors
-are in the README.
+corner the cell that holds the vertex also holds the neighbouring wall. VCT's cones from there see into that wall,
+so its corners are evaluated 1.0 cell in; the LPV's receivers keep each wall's surfaces apart within a voxel
+(lpv/receivers.py), so its corners need only a little (0.3 cells: best on spot_room, within 0.005 of the best on
+the Cornell box and 0.02 on the courtyard). Each corner is evaluated at the vertex moved INSET_CELLS cells of the
+method's grid toward its face's centre (at most INSET_LIMIT of the way there, so a small face keeps its sample
+inside), with the corner's normal, and the corners are averaged per vertex, as Cycles does. Method "none" has no
+grid and is evaluated at the vertices. The measured errors are in the README.
 
 start_bake() collects the corners (foreach_get into numpy, no per-vertex Python loops) and extracts the scene on the
 main thread, then submits one GPU job for every corner of every mesh (Engine.submit_points); finish_bake() writes the
@@ -29,9 +30,9 @@ import numpy as np
 from .preview import PreviewError, one_line, render_settings_of, wait_result
 
 ATTRIBUTE = "BounceGI"
-# How far a corner's sample moves toward its face's centre, in cells of the method's grid: where each method's
-# light is no longer that of the neighbouring surface's cell (chosen on cornell, spot_room, courtyard; README).
-INSET_CELLS = {"lpv": 1.2, "vct": 1.0}
+# How far a corner's sample moves toward its face's centre, in cells of the method's grid (chosen on cornell,
+# spot_room, courtyard: the docstring; README).
+INSET_CELLS = {"lpv": 0.3, "vct": 1.0}
 INSET_LIMIT = 0.45  # ... but at most this fraction of the way to the centre
 EXTRACT_SIZE = (64, 64)  # the bake renders no image; extraction wants a size
 
