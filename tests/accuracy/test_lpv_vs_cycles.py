@@ -23,23 +23,25 @@ A change that makes either worse fails here; one that makes it better should low
 import pytest
 
 SCENES = ("cornell", "spot_room", "courtyard")
-# measured, rel-L1 Diffuse Indirect / Combined (8 bounces), transfer: cornell 0.107 / 0.056, spot_room 0.135 /
-# 0.051, courtyard 0.134 / 0.095 (gather, before the lattice's 1/3-cell phase: 0.108 / 0.055, 0.115 / 0.044,
+# measured, rel-L1 Diffuse Indirect / Combined (8 bounces), transfer with its receivers per axis (2026-12-03):
+# cornell 0.087 / 0.047, spot_room 0.087 / 0.033, courtyard 0.118 / 0.084 (before them 0.107 / 0.056, 0.135 /
+# 0.051, 0.134 / 0.095; gather, before the lattice's 1/3-cell phase: 0.108 / 0.055, 0.115 / 0.044,
 # 0.140 / 0.099)
 GATHER_FULL = {"cornell": {"diffuse_indirect": 0.17, "combined": 0.11},
                "spot_room": {"diffuse_indirect": 0.18, "combined": 0.10},
                "courtyard": {"diffuse_indirect": 0.20, "combined": 0.16}}
-# measured (1 bounce each side), transfer: cornell 0.083 / 0.037, spot_room 0.104 / 0.015, courtyard 0.088 / 0.043
-# (gather, before the lattice's phase: 0.089 / 0.037, 0.072 / 0.010, 0.095 / 0.046)
+# measured (1 bounce each side), transfer (2026-12-03): cornell 0.077 / 0.035, spot_room 0.082 / 0.012, courtyard
+# 0.082 / 0.041 (before the receivers per axis 0.083 / 0.037, 0.104 / 0.015, 0.088 / 0.043; gather, before the lattice's phase: 0.089 / 0.037, 0.072 / 0.010, 0.095 / 0.046)
 GATHER_ONE_BOUNCE = {"cornell": {"diffuse_indirect": 0.15, "combined": 0.09},
                      "spot_room": {"diffuse_indirect": 0.13, "combined": 0.07},
                      "courtyard": {"diffuse_indirect": 0.15, "combined": 0.10}}
-# propagate, measured (ours 3 bounces, Cycles 8): cornell 0.687 / 0.328, spot_room 1.237 / 0.474,
-# courtyard 0.971 / 0.660
+# propagate, measured (ours 3 bounces, Cycles 8; 2026-12-03): cornell 0.672 / 0.321, spot_room 1.247 / 0.478,
+# courtyard 1.019 / 0.691
 PROPAGATE_FULL = {"cornell": {"diffuse_indirect": 0.78, "combined": 0.40},
                   "spot_room": {"diffuse_indirect": 1.35, "combined": 0.55},
                   "courtyard": {"diffuse_indirect": 1.07, "combined": 0.74}}
-# propagate, measured (1 bounce each side): cornell 0.885 / 0.309, spot_room 2.892 / 0.441, courtyard 1.867 / 0.724
+# propagate, measured (1 bounce each side; 2026-12-03): cornell 0.875 / 0.303, spot_room 2.909 / 0.443, courtyard
+# 1.823 / 0.706
 PROPAGATE_ONE_BOUNCE = {"cornell": {"diffuse_indirect": 0.99, "combined": 0.38},
                         "spot_room": {"diffuse_indirect": 3.09, "combined": 0.52},
                         "courtyard": {"diffuse_indirect": 2.06, "combined": 0.83}}
