@@ -10,7 +10,8 @@ pass: the fragment shader (gpu_kernels/shaders/viewport/surface.glsl) looks the 
 
 The triangles are drawn in a batch per shader variant: those whose material's diffuse share is the same from
 every view (Diffuse BSDF, Principled without a specular layer) skip the per-pixel lookup of the share, a fifth of
-a full-screen redraw on llvmpipe (benchmarks/results/viewport_llvmpipe.md).
+a full-screen redraw on llvmpipe (benchmarks/results/viewport_llvmpipe.md); of the others, those whose share a
+polynomial in μ fits evaluate it instead of sampling the table.
 
 Must run where Blender's `gpu` module draws: the main thread of an interactive Blender, or background mode after
 one tiny Workbench render (ensure_gpu).
@@ -23,7 +24,7 @@ import gpu
 import numpy as np
 from mathutils import Matrix
 
-from ..gpu_kernels.common.principled import ROWS_PER_MATERIAL
+from ..gpu_kernels.common.principled import ROWS_PER_MATERIAL, share_polynomial
 from ..gpu_kernels.gl.preprocessor import load
 from ..gpu_kernels.surface.mesh import ATTRIBUTES
 
@@ -31,7 +32,13 @@ SHADER_FILE = "viewport/surface.glsl"
 # Display mode → (weight of the direct light and emission, weight of the indirect light).
 MODES = {"COMBINED": (1.0, 1.0), "INDIRECT": (0.0, 1.0), "DIRECT": (1.0, 0.0)}
 GLSL_TYPES = {2: "VEC2", 3: "VEC3", 4: "VEC4"}
-CONSTANT, TABLE = "constant", "table"  # the shader variants: share as a vertex attribute, or from the table
+# The shader variants: the share as a vertex attribute, as a polynomial in μ, or from the table.
+CONSTANT, POLY, TABLE = "constant", "poly", "table"
+DEFINES = {CONSTANT: {"CONSTANT_SHARE": True}, POLY: {"POLY_SHARE": True}, TABLE: None}
+# A material's share is drawn from its polynomial where that is this close to the table everywhere: a tenth of the
+# 0.01 within which Diffuse Color counts as matching Cycles', below what a half-float framebuffer keeps of a
+# share near 1 (2⁻¹¹ ≈ 5·10⁻⁴, twice that at most over the light it multiplies).
+POLY_TOLERANCE = 1e-3
 # Vertex inputs (surface/mesh.draw_arrays's, but `mat`): `material` is the CONSTANT variant's share (rgb) and the
 # TABLE variant's layer in the share table (a), one buffer for both variants.
 SHARED_INPUTS = (("pos", 3), ("geo", 3), ("tile", 2), ("box", 3), ("tile_i", 2), ("box_i", 3), ("emission", 3),
@@ -39,6 +46,8 @@ SHARED_INPUTS = (("pos", 3), ("geo", 3), ("tile", 2), ("box", 3), ("tile_i", 2),
 ATLASES = (("u_direct", "FLOAT_2D"), ("u_indirect", "FLOAT_2D"))
 VARIANTS = {  # variant → (vertex inputs beyond SHARED_INPUTS, samplers, smooth and flat outputs beyond the shared)
     CONSTANT: ((), ATLASES, (), (("v_page", 2), ("v_share", 3))),
+    POLY: ((("nrm", 3),), (*ATLASES, ("u_share_poly", "FLOAT_2D")), (("v_view", 3), ("v_normal", 3)),
+           (("v_page", 4), *((f"v_{c}{k}", 4) for c in "rgb" for k in (0, 1)))),
     TABLE: ((("nrm", 3),), (*ATLASES, ("u_material_lut", "FLOAT_1D_ARRAY")), (("v_view", 3), ("v_normal", 3)),
             (("v_page", 4),)),
 }
@@ -47,7 +56,7 @@ _shaders = {}
 
 def stage_source(stage: str, variant: str = TABLE) -> str:
     """One stage of the viewport shader, includes expanded, without #version (Blender writes its own)."""
-    text = load(SHADER_FILE, defines={"CONSTANT_SHARE": True} if variant == CONSTANT else None, stage=stage).text
+    text = load(SHADER_FILE, defines=DEFINES[variant], stage=stage).text
     return "\n".join(line for line in text.splitlines() if not line.lstrip().startswith("#version")) + "\n"
 
 
@@ -146,12 +155,13 @@ def size_order(positions) -> np.ndarray:
     return np.argsort((area2.view(np.int32) >> 15).astype(np.uint16), kind="stable")
 
 
-def split_mesh(mesh: dict, rows: np.ndarray, layers: int) -> tuple[dict, list]:
+def split_mesh(mesh: dict, rows: np.ndarray, layers: int, fits=None) -> tuple[dict, list]:
     """The triangles (surface/mesh.draw_arrays) as one set of vertex arrays and the parts that draw them,
     [(variant, (K, 3) uint32 corner indices, first material)]: CONSTANT for those whose material's share D(μ) is
-    the same at every μ (Diffuse BSDF, Principled with no specular layer; attribute `share`), then TABLE, `layers`
-    materials a part (a 1D array texture's layers: 2048 on llvmpipe and what GL 4.3 guarantees; `material` holds
-    the index within the part). One vertex buffer serves every part: copies per part took longer to make than the
+    the same at every μ (Diffuse BSDF, Principled with no specular layer; attribute `share`), then POLY for those
+    whose material `fits` (M,) bool says a polynomial fits, then TABLE; POLY and TABLE `layers` materials a part
+    (a 1D array texture's layers: 2048 on llvmpipe and what GL 4.3 guarantees; `material` holds the index within
+    the part). One vertex buffer serves every part: copies per part took longer to make than the
     buffer itself.
 
     Smallest triangles first: they are mostly the details in front of the large walls, floors and ground, and a
@@ -160,14 +170,16 @@ def split_mesh(mesh: dict, rows: np.ndarray, layers: int) -> tuple[dict, list]:
     order = size_order(mesh["pos"])
     material = np.clip(np.rint(np.asarray(mesh["mat"])[0::3, 0]).astype(np.int64), 0, len(rows) - 1)
     constant = np.all(rows[..., :3] == rows[:, :1, :3], axis=(1, 2))[material][order]
+    poly = ~constant & (np.zeros(len(rows), bool) if fits is None else np.asarray(fits, bool))[material][order]
     chunk = (material // layers)[order]
     arrays = {name: np.asarray(mesh[name], np.float32) for name, _ in ATTRIBUTES if name != "mat"}
     per_material = np.concatenate([rows[:, 0, :3], (np.arange(len(rows)) % layers)[:, None]], axis=1)
     arrays["material"] = np.repeat(np.take(per_material.astype(np.float32), material, axis=0), 3, axis=0)
     corners = order.astype(np.uint32)[:, None] * 3 + np.arange(3, dtype=np.uint32)
     parts = [(CONSTANT, corners[constant], 0)]
-    parts += [(TABLE, corners[~constant & (chunk == c)], c * layers)
-              for c in range(int(chunk[~constant].max(initial=-1)) + 1)]
+    for variant, mine in ((POLY, poly), (TABLE, ~constant & ~poly)):
+        parts += [(variant, corners[mine & (chunk == c)], c * layers)
+                  for c in range(int(chunk[mine].max(initial=-1)) + 1)]
     return arrays, [part for part in parts if len(part[1])]
 
 
@@ -197,12 +209,15 @@ class SurfaceDrawing:
         if not self.triangles:
             return
         rows, layers = share_rows(material_lut_of(light)), gpu.capabilities.max_texture_layers_get()
-        arrays, parts = split_mesh(light.mesh, rows, layers)
+        coeffs, error = share_polynomial(rows)
+        arrays, parts = split_mesh(light.mesh, rows, layers, error <= POLY_TOLERANCE)
         vbo = vertex_buffer(arrays)
         for variant, corners, first in parts:
             textures = dict(atlases)
             if variant == TABLE:
                 textures["u_material_lut"] = layers_texture(rows[first:first + layers])
+            elif variant == POLY:  # a row per material: its channels' coefficients, two texels each
+                textures["u_share_poly"] = rgba_texture(coeffs[first:first + layers].reshape(-1, 6, 4))
             batch = gpu.types.GPUBatch(type="TRIS", buf=vbo, elem=gpu.types.GPUIndexBuf(type="TRIS", seq=corners))
             self.parts.append((variant, batch, textures))
 

@@ -181,3 +181,22 @@ def transport_albedo(mat) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         scale = scale + (dark * (1.0 - s5)[:, None] * w).sum(axis=0)
         offset = offset + (dark * s5[:, None] * w).sum(axis=0)
     return scale, offset, diffuse
+
+
+SHARE_TERMS = 8  # polynomial terms of the viewport's fitted diffuse share (share_polynomial)
+
+
+def share_polynomial(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The diffuse share D(μ) of each material's table row (rows (M, S, ≥3): rgb D at μ = k/(S−1), as
+    material_lut's row 0) fitted by least squares with a polynomial of SHARE_TERMS terms in t = 2μ − 1, so that
+    the viewport evaluates a few multiply-adds per pixel instead of a texture lookup (llvmpipe pays every fragment
+    instruction ~500 000 times a redraw, and its texture sampling is dozens of them). Returns the coefficients
+    (M, 3, SHARE_TERMS) — per channel, of 1, t, t², … — and each material's largest deviation from its row (M,).
+    t on [−1, 1] keeps the monomials well conditioned and the float32 sum free of cancellation."""
+    rows = np.asarray(rows, np.float64)[..., :3]
+    t = 2.0 * np.linspace(0.0, 1.0, rows.shape[1]) - 1.0
+    basis = t[:, None] ** np.arange(SHARE_TERMS)[None, :]  # (S, terms)
+    values = rows.transpose(1, 0, 2).reshape(rows.shape[1], -1)  # (S, M·3)
+    coeffs, *_ = np.linalg.lstsq(basis, values, rcond=None)
+    error = np.abs(basis @ coeffs - values).reshape(rows.shape[1], len(rows), 3).max(axis=(0, 2))
+    return coeffs.T.reshape(len(rows), 3, SHARE_TERMS), error

@@ -15,7 +15,10 @@
 // over a triangle is worked out per vertex and handed on flat: which page of the atlas the camera sees, the
 // tile's clamp bounds, the normal's sign. Variant CONSTANT_SHARE (ui/draw.py defines it) draws the triangles
 // whose material's diffuse share does not depend on the view (Diffuse BSDF, Principled with no specular layer):
-// the share comes as a vertex attribute, and the fragment skips the material table and the view vector.
+// the share comes as a vertex attribute, and the fragment skips the material table and the view vector. Variant
+// POLY_SHARE draws those whose share a polynomial in μ fits (common/principled.share_polynomial, within
+// draw.POLY_TOLERANCE of the table): a few multiply-adds per fragment instead of a filtered texture lookup; the
+// rest (a coat's steep Fresnel, mostly) read the table.
 //
 // Push constants: u_view_projection; u_eye (xyz camera position, w 1 if orthographic); u_forward (xyz unit view
 // axis, w depth pulled toward the camera, in clip w — the overlay draws over Blender's own copy of the same
@@ -43,6 +46,17 @@ void main() {
     v_view = to_eye;
     v_normal = nrm;
 #endif
+#if defined(POLY_SHARE)
+    // The material's share polynomial (common/principled.share_polynomial): row material.a of u_share_poly,
+    // two texels per channel — fetched per vertex and handed on flat, so no fragment touches a texture for it.
+    ivec2 row = ivec2(0, int(material.a + 0.5));
+    v_r0 = texelFetch(u_share_poly, row, 0);
+    v_r1 = texelFetch(u_share_poly, row + ivec2(1, 0), 0);
+    v_g0 = texelFetch(u_share_poly, row + ivec2(2, 0), 0);
+    v_g1 = texelFetch(u_share_poly, row + ivec2(3, 0), 0);
+    v_b0 = texelFetch(u_share_poly, row + ivec2(4, 0), 0);
+    v_b1 = texelFetch(u_share_poly, row + ivec2(5, 0), 0);
+#endif
     gl_Position = u_view_projection * vec4(pos, 1.0);
     gl_Position.z -= u_forward.w * gl_Position.w;
 }
@@ -61,11 +75,22 @@ void main() {
 #if defined(CONSTANT_SHARE)
     vec3 share = v_share;
 #else
-    // The material's diffuse share at μ = n·v (one inverse square root for both lengths): its table row is layer
-    // v_page.w of u_material_lut, a 1D array texture, so linear filtering blends two texels, not four.
-    float mu = v_page.z * dot(v_normal, v_view) * inversesqrt(dot(v_normal, v_normal) * dot(v_view, v_view));
+    // The material's diffuse share at μ = n·v (one inverse square root for both lengths).
+    float mu = clamp(v_page.z * dot(v_normal, v_view) * inversesqrt(dot(v_normal, v_normal) * dot(v_view, v_view)),
+                     0.0, 1.0);
+#if defined(POLY_SHARE)
+    // Σ c_k t^k, t = 2μ − 1, k < 8: the powers in two vec4s, a channel's coefficients in two more.
+    float t = 2.0 * mu - 1.0;
+    vec4 low = vec4(1.0, t, t * t, t * t * t);
+    vec4 high = low * (low.z * low.z);
+    vec3 share = vec3(dot(v_r0, low) + dot(v_r1, high), dot(v_g0, low) + dot(v_g1, high),
+                      dot(v_b0, low) + dot(v_b1, high));
+#else
+    // Its table row is layer v_page.w of u_material_lut, a 1D array texture, so linear filtering blends two
+    // texels, not four.
     float size = float(textureSize(u_material_lut, 0).x);
-    vec3 share = texture(u_material_lut, vec2((clamp(mu, 0.0, 1.0) * (size - 1.0) + 0.5) / size, v_page.w)).rgb;
+    vec3 share = texture(u_material_lut, vec2((mu * (size - 1.0) + 0.5) / size, v_page.w)).rgb;
+#endif
 #endif
     vec3 light = u_params.z * atlas_lookup(u_direct, c) + u_params.w * atlas_lookup(u_indirect, c_i);
     out_color = vec4(share * light + u_params.z * v_emission, 1.0);
