@@ -10,7 +10,9 @@
     those meshes costs at least). The two alternate, round after round, so a load that comes and goes on the
     machine falls on both; each redraw is timed up to a 1-pixel read-back, which waits for the GL to finish (on
     llvmpipe a draw call only queues the work); the medians of 60 rounds after 5 of warm-up, and the median of
-    the rounds' differences;
+    the rounds' differences; with them how many cores other processes kept busy meanwhile (/proc/stat's busy
+    time less this process's own CPU time): llvmpipe's times double when another process holds one of 2 cores,
+    so a reading above LOADED_CORES flags the line;
   - F12 (the render engine, the scene camera, 160×120), with every pass run and again with the cache holding.
 
     .venv/bin/python benchmarks/viewport_bench.py [--method lpv|vct|none] [--scenes cornell spot_room courtyard]
@@ -30,6 +32,32 @@ import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)  # examples/
+
+
+# Cores other processes may keep busy, on average, before a redraw line is flagged as measured under load (a
+# desktop's idle background stays under a tenth of a core).
+LOADED_CORES = 0.2
+
+
+def cpu_sample():
+    """(seconds all cores spent busy since boot, this process's CPU seconds, wall-clock seconds), or None where
+    /proc/stat is missing (not Linux). Busy is all but idle and iowait; steal counts too: a virtual machine's
+    core taken by the host is as lost to llvmpipe as one taken by a process."""
+    try:
+        with open("/proc/stat") as f:
+            ticks = [int(x) for x in f.readline().split()[1:9]]
+    except (OSError, ValueError):
+        return None
+    t = os.times()  # all this process's threads, llvmpipe's included
+    return (sum(ticks) - ticks[3] - ticks[4]) / os.sysconf("SC_CLK_TCK"), t.user + t.system, time.perf_counter()
+
+
+def others_busy(before, after):
+    """Cores other processes kept busy on average between two cpu_samples (None if either is None)."""
+    if before is None or after is None:
+        return None
+    busy, own, wall = (b - a for a, b in zip(before, after))
+    return max(0.0, (busy - own) / wall) if wall > 0 else None
 
 
 def timed_rounds(draws: dict, target, rounds=60, warm_up=5) -> dict:
@@ -74,8 +102,9 @@ def flat_draw(positions, view):
 
 
 def redraw_costs(drawing, positions, world, sizes) -> dict:
-    """(w, h) → (ours, flat, median of the rounds' differences) in seconds: Rendered shading's redraw and Blender's
-    flat builtin shader drawing the same triangles, from the scene camera."""
+    """(w, h) → (ours, flat, median of the rounds' differences in seconds, cores others kept busy meanwhile):
+    Rendered shading's redraw and Blender's flat builtin shader drawing the same triangles, from the scene
+    camera."""
     import bpy
     import gpu
 
@@ -86,11 +115,14 @@ def redraw_costs(drawing, positions, world, sizes) -> dict:
     for w, h in sizes:
         target = gpu.types.GPUOffScreen(w, h, format="RGBA16F")  # the 3D view's colour buffer is RGBA16F too
         view = draw.camera_view(read_camera(bpy.context.scene), w, h)
+        before = cpu_sample()
         times = timed_rounds({"ours": lambda: draw.draw_view3d(drawing, view, world),
                               "flat": flat_draw(positions, view)}, target)
+        load = others_busy(before, cpu_sample())
         target.free()
         diff = [a - b for a, b in zip(times["ours"], times["flat"])]
-        out[(w, h)] = (statistics.median(times["ours"]), statistics.median(times["flat"]), statistics.median(diff))
+        out[(w, h)] = (statistics.median(times["ours"]), statistics.median(times["flat"]), statistics.median(diff),
+                       load)
     return out
 
 
@@ -216,11 +248,19 @@ def print_scene(name: str, method: str, r: dict) -> None:
         cells = "".join(f"{lat[k]:>8.2f}s" if k in lat else f"{'-':>9}" for k in ("direct", "draft", "final"))
         print(f"{label:<17}{cells}{row['handler'] * 1000:>8.1f}ms{row['upload'] * 1000:>7.1f}ms   "
               f"{row['changed']}{'  ERROR ' + row['error'] if row['error'] else ''}")
-    for (w, h), (ours, flat, diff) in r["redraw"].items():
+    for (w, h), (ours, flat, diff, load) in r["redraw"].items():
         print(f"redraw {w}x{h}: ours {ours * 1000:.2f} ms, builtin flat shader {flat * 1000:.2f} ms, "
-              f"difference {diff * 1000:.2f} ms")
+              f"difference {diff * 1000:.2f} ms; {load_note(load)}")
     if r["f12"]:
         print(f"F12 160x120: {r['f12']['cold']:.2f} s with every pass run, {r['f12']['again']:.2f} s again")
+
+
+def load_note(load) -> str:
+    """What the redraw line says of the other processes' load during its rounds."""
+    if load is None:
+        return "other processes' load unknown (no /proc/stat)"
+    flag = f" — LOADED (over {LOADED_CORES}): llvmpipe's times are inflated" if load > LOADED_CORES else ""
+    return f"other processes kept {load:.2f} of {os.cpu_count()} cores busy{flag}"
 
 
 def main(argv=None) -> None:
