@@ -8,10 +8,12 @@ own atlas), the materials' diffuse-share rows and the vertex batches. Blender's 
 place, so a new result makes new ones and the old are freed. Drawing it from a camera runs no GI
 pass: the fragment shader (gpu_kernels/shaders/viewport/surface.glsl) looks the light up per pixel.
 
-The triangles are drawn in a batch per shader variant: those whose material's diffuse share is the same from
-every view (Diffuse BSDF, Principled without a specular layer) skip the per-pixel lookup of the share, a fifth of
-a full-screen redraw on llvmpipe (benchmarks/results/viewport_llvmpipe.md); of the others, those whose share a
-polynomial in μ fits evaluate it instead of sampling the table.
+The triangles are drawn in a batch per shader variant (draw_parts.py): those whose material's diffuse share is
+the same from every view (Diffuse BSDF, Principled without a specular layer) skip the per-pixel lookup of the
+share, a fifth of a full-screen redraw on llvmpipe (benchmarks/results/viewport_llvmpipe.md); of the others, those
+whose share a polynomial in μ fits evaluate it instead of sampling the table; triangles with one normal get it
+flat. Each variant is compiled per display mode, when first drawn, and every redraw draws the triangles facing
+the camera before the others.
 
 Must run where Blender's `gpu` module draws: the main thread of an interactive Blender, or background mode after
 one tiny Workbench render (ensure_gpu).
@@ -24,70 +26,84 @@ import gpu
 import numpy as np
 from mathutils import Matrix
 
-from ..gpu_kernels.common.principled import ROWS_PER_MATERIAL, share_polynomial
+from ..gpu_kernels.common.principled import share_polynomial
 from ..gpu_kernels.gl.preprocessor import load
-from ..gpu_kernels.surface.mesh import ATTRIBUTES
+from .draw_parts import CONSTANT, GREY, POLY, TABLE, share_rows, split_mesh
 
 SHADER_FILE = "viewport/surface.glsl"
-# Display mode → (weight of the direct light and emission, weight of the indirect light).
-MODES = {"COMBINED": (1.0, 1.0), "INDIRECT": (0.0, 1.0), "DIRECT": (1.0, 0.0)}
+# Display mode → the light its shader adds up (a variant each: no fragment multiplies by a weight of 0 or 1).
+MODES = {"COMBINED": ("DIRECT_LIGHT", "INDIRECT_LIGHT"), "INDIRECT": ("INDIRECT_LIGHT",), "DIRECT": ("DIRECT_LIGHT",)}
 GLSL_TYPES = {2: "VEC2", 3: "VEC3", 4: "VEC4"}
-# The shader variants: the share as a vertex attribute, as a polynomial in μ, or from the table.
-CONSTANT, POLY, TABLE = "constant", "poly", "table"
-DEFINES = {CONSTANT: {"CONSTANT_SHARE": True}, POLY: {"POLY_SHARE": True}, TABLE: None}
+SHARE_DEFINES = {CONSTANT: ("CONSTANT_SHARE",), GREY: ("POLY_SHARE", "GREY_SHARE"), POLY: ("POLY_SHARE",),
+                 TABLE: ()}
 # A material's share is drawn from its polynomial where that is this close to the table everywhere: a tenth of the
 # 0.01 within which Diffuse Color counts as matching Cycles', below what a half-float framebuffer keeps of a
 # share near 1 (2⁻¹¹ ≈ 5·10⁻⁴, twice that at most over the light it multiplies).
 POLY_TOLERANCE = 1e-3
 # Vertex inputs (surface/mesh.draw_arrays's, but `mat`): `material` is the CONSTANT variant's share (rgb) and the
-# TABLE variant's layer in the share table (a), one buffer for both variants.
+# others' row in the part's share table or polynomial texture (a), one buffer for all variants.
 SHARED_INPUTS = (("pos", 3), ("geo", 3), ("tile", 2), ("box", 3), ("tile_i", 2), ("box_i", 3), ("emission", 3),
                  ("material", 4))
 ATLASES = (("u_direct", "FLOAT_2D"), ("u_indirect", "FLOAT_2D"))
-VARIANTS = {  # variant → (vertex inputs beyond SHARED_INPUTS, samplers, smooth and flat outputs beyond the shared)
-    CONSTANT: ((), ATLASES, (), (("v_page", 2), ("v_share", 3))),
-    POLY: ((("nrm", 3),), (*ATLASES, ("u_share_poly", "FLOAT_2D")), (("v_view", 3), ("v_normal", 3)),
-           (("v_page", 4), *((f"v_{c}{k}", 4) for c in "rgb" for k in (0, 1)))),
-    TABLE: ((("nrm", 3),), (*ATLASES, ("u_material_lut", "FLOAT_1D_ARRAY")), (("v_view", 3), ("v_normal", 3)),
-            (("v_page", 4),)),
-}
+POLY_SAMPLER, TABLE_SAMPLER = ("u_share_poly", "FLOAT_2D"), ("u_material_lut", "FLOAT_1D_ARRAY")
+SHARE_SAMPLERS = {CONSTANT: (), GREY: (POLY_SAMPLER,), POLY: (POLY_SAMPLER,), TABLE: (TABLE_SAMPLER,)}
+# The polynomial's coefficients, two vec4s a channel, handed on flat: of the red channel alone where all are grey.
+SHARE_OUTPUTS = {CONSTANT: (), GREY: (("v_r0", 4), ("v_r1", 4)), TABLE: (),
+                 POLY: tuple((f"v_{c}{k}", 4) for c in "rgb" for k in (0, 1))}
 _shaders = {}
 
 
-def stage_source(stage: str, variant: str = TABLE) -> str:
+def interface(share: str, flat: bool) -> tuple:
+    """(vertex inputs beyond SHARED_INPUTS, samplers, smooth and flat outputs beyond the shared) of a variant."""
+    samplers = (*ATLASES, *SHARE_SAMPLERS[share])
+    if share == CONSTANT:
+        return (), samplers, (), (("v_page", 2), ("v_share", 3))
+    smooth, flat_out = [("v_view", 3)], [("v_page", 4)]
+    (flat_out if flat else smooth).append(("v_normal", 3))
+    return (("nrm", 3),), samplers, tuple(smooth), (*flat_out, *SHARE_OUTPUTS[share])
+
+
+def variant_defines(share: str, flat: bool, mode: str) -> dict:
+    """The #defines of a variant (viewport/surface.glsl names them)."""
+    flat_normal = ("FLAT_NORMAL",) if flat and share != CONSTANT else ()
+    return {name: None for name in (*SHARE_DEFINES[share], *flat_normal, *MODES[mode])}
+
+
+def stage_source(stage: str, share: str = TABLE, flat: bool = False, mode: str = "COMBINED") -> str:
     """One stage of the viewport shader, includes expanded, without #version (Blender writes its own)."""
-    text = load(SHADER_FILE, defines=DEFINES[variant], stage=stage).text
+    text = load(SHADER_FILE, defines=variant_defines(share, flat, mode), stage=stage).text
     return "\n".join(line for line in text.splitlines() if not line.lstrip().startswith("#version")) + "\n"
 
 
-def vertex_inputs(variant: str) -> list:
+def vertex_inputs(share: str, flat: bool = False) -> list:
     """(name, components) of the variant's vertex attributes, in declaration order."""
-    return [*SHARED_INPUTS, *VARIANTS[variant][0]]
+    return [*SHARED_INPUTS, *interface(share, flat)[0]]
 
 
-def surface_shader(variant: str = TABLE):
-    """The viewport's surface shader of one variant (compiled once per Blender session)."""
-    if variant not in _shaders:
-        _, samplers, smooth, flat = VARIANTS[variant]
-        iface = gpu.types.GPUStageInterfaceInfo(f"bounce_gi_surface_{variant}_iface")
+def surface_shader(share: str = TABLE, flat: bool = False, mode: str = "COMBINED"):
+    """The viewport's surface shader of one variant (compiled once per Blender session, when first drawn)."""
+    key = (share, flat, mode)
+    if key not in _shaders:
+        _, samplers, smooth, flat_out = interface(share, flat)
+        iface = gpu.types.GPUStageInterfaceInfo(f"bounce_gi_surface_{share}_{int(flat)}_{mode.lower()}_iface")
         for name, n in (("v_tile", 2), ("v_tile_i", 2), *smooth):
             iface.smooth(GLSL_TYPES[n], name)
-        for name, n in (("v_clamp", 4), ("v_clamp_i", 4), ("v_emission", 3), *flat):
+        for name, n in (("v_clamp", 4), ("v_clamp_i", 4), ("v_emission", 3), *flat_out):
             iface.flat(GLSL_TYPES[n], name)
         info = gpu.types.GPUShaderCreateInfo()
         for name, glsl_type in (("u_view_projection", "MAT4"), ("u_eye", "VEC4"), ("u_forward", "VEC4"),
-                                ("u_params", "VEC4")):
+                                ("u_pages", "VEC2")):
             info.push_constant(glsl_type, name)
         for slot, (name, sampler_type) in enumerate(samplers):
             info.sampler(slot, sampler_type, name)
-        for slot, (name, n) in enumerate(vertex_inputs(variant)):
+        for slot, (name, n) in enumerate(vertex_inputs(share, flat)):
             info.vertex_in(slot, GLSL_TYPES[n], name)
         info.vertex_out(iface)
         info.fragment_out(0, "VEC4", "out_color")
-        info.vertex_source(stage_source("vertex", variant))
-        info.fragment_source(stage_source("fragment", variant))
-        _shaders[variant] = gpu.shader.create_from_info(info)
-    return _shaders[variant]
+        info.vertex_source(stage_source("vertex", share, flat, mode))
+        info.fragment_source(stage_source("fragment", share, flat, mode))
+        _shaders[key] = gpu.shader.create_from_info(info)
+    return _shaders[key]
 
 
 def release_shader() -> None:
@@ -138,51 +154,6 @@ class View:
     ortho: bool = False
 
 
-def share_rows(lut: np.ndarray) -> np.ndarray:
-    """(M, S, 4): each material's diffuse-share row of the Principled table (row 0 of its ROWS_PER_MATERIAL:
-    rgb D(μ) at μ = k/(S−1), common/principled.glsl), the only one the viewport reads."""
-    return np.asarray(lut, np.float32)[0::ROWS_PER_MATERIAL]
-
-
-def size_order(positions) -> np.ndarray:
-    """The triangles (3 corners a row of `positions`), smallest first: sorted by the float bits of their squared
-    doubled area, an integer key monotonic in it, 1/256 octave steps (equal keys keep their order). numpy sorts
-    16-bit keys in linear time: 2 ms for 100 000 triangles on Blender's main thread, a float sort took 15."""
-    corner = np.ascontiguousarray(np.asarray(positions, np.float32).reshape(-1, 3, 3).transpose(2, 1, 0))
-    e1, e2 = corner[:, 1] - corner[:, 0], corner[:, 2] - corner[:, 0]  # (xyz, triangle)
-    cross = (e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0])
-    area2 = np.maximum(sum(c * c for c in cross), 0.0).astype(np.float32)
-    return np.argsort((area2.view(np.int32) >> 15).astype(np.uint16), kind="stable")
-
-
-def split_mesh(mesh: dict, rows: np.ndarray, layers: int, fits=None) -> tuple[dict, list]:
-    """The triangles (surface/mesh.draw_arrays) as one set of vertex arrays and the parts that draw them,
-    [(variant, (K, 3) uint32 corner indices, first material)]: CONSTANT for those whose material's share D(μ) is
-    the same at every μ (Diffuse BSDF, Principled with no specular layer; attribute `share`), then POLY for those
-    whose material `fits` (M,) bool says a polynomial fits, then TABLE; POLY and TABLE `layers` materials a part
-    (a 1D array texture's layers: 2048 on llvmpipe and what GL 4.3 guarantees; `material` holds the index within
-    the part). One vertex buffer serves every part: copies per part took longer to make than the
-    buffer itself.
-
-    Smallest triangles first: they are mostly the details in front of the large walls, floors and ground, and a
-    fragment that fails the depth test is not shaded — in this order llvmpipe shaded 8-14 % less of a redraw on
-    the example rooms. Any order draws the same image, but where coincident surfaces tie in depth."""
-    order = size_order(mesh["pos"])
-    material = np.clip(np.rint(np.asarray(mesh["mat"])[0::3, 0]).astype(np.int64), 0, len(rows) - 1)
-    constant = np.all(rows[..., :3] == rows[:, :1, :3], axis=(1, 2))[material][order]
-    poly = ~constant & (np.zeros(len(rows), bool) if fits is None else np.asarray(fits, bool))[material][order]
-    chunk = (material // layers)[order]
-    arrays = {name: np.asarray(mesh[name], np.float32) for name, _ in ATTRIBUTES if name != "mat"}
-    per_material = np.concatenate([rows[:, 0, :3], (np.arange(len(rows)) % layers)[:, None]], axis=1)
-    arrays["material"] = np.repeat(np.take(per_material.astype(np.float32), material, axis=0), 3, axis=0)
-    corners = order.astype(np.uint32)[:, None] * 3 + np.arange(3, dtype=np.uint32)
-    parts = [(CONSTANT, corners[constant], 0)]
-    for variant, mine in ((POLY, poly), (TABLE, ~constant & ~poly)):
-        parts += [(variant, corners[mine & (chunk == c)], c * layers)
-                  for c in range(int(chunk[mine].max(initial=-1)) + 1)]
-    return arrays, [part for part in parts if len(part[1])]
-
-
 def vertex_buffer(arrays: dict):
     """name → (N, C) float32 arrays as one GPUVertBuf (the shaders find their inputs by name)."""
     fmt = gpu.types.GPUVertFormat()
@@ -205,41 +176,47 @@ class SurfaceDrawing:
         atlases = {"u_direct": rgba_texture(light.direct * np.concatenate([light.base, light.base])),
                    "u_indirect": rgba_texture(light.indirect * np.concatenate([coarse_base, coarse_base]))}
         self.triangles = len(light.mesh["pos"]) // 3
-        self.parts = []  # (variant, batch, {sampler: texture}), in drawing order
+        self.parts = []  # ((share, flat), batch, {sampler: texture}), in drawing order
         if not self.triangles:
             return
         rows, layers = share_rows(material_lut_of(light)), gpu.capabilities.max_texture_layers_get()
         coeffs, error = share_polynomial(rows)
         arrays, parts = split_mesh(light.mesh, rows, layers, error <= POLY_TOLERANCE)
         vbo = vertex_buffer(arrays)
-        for variant, corners, first in parts:
+        shares = {}  # (sampler, first material) → its table or polynomial texture, made once for all its parts
+        for (share, flat), corners, first in parts:
             textures = dict(atlases)
-            if variant == TABLE:
-                textures["u_material_lut"] = layers_texture(rows[first:first + layers])
-            elif variant == POLY:  # a row per material: its channels' coefficients, two texels each
-                textures["u_share_poly"] = rgba_texture(coeffs[first:first + layers].reshape(-1, 6, 4))
+            for sampler, _ in SHARE_SAMPLERS[share]:
+                if (sampler, first) not in shares:  # polynomials: a material a row, its channels' 2 texels each
+                    shares[sampler, first] = (layers_texture(rows[first:first + layers]) if share == TABLE else
+                                              rgba_texture(coeffs[first:first + layers].reshape(-1, 6, 4)))
+                textures[sampler] = shares[sampler, first]
             batch = gpu.types.GPUBatch(type="TRIS", buf=vbo, elem=gpu.types.GPUIndexBuf(type="TRIS", seq=corners))
-            self.parts.append((variant, batch, textures))
+            self.parts.append(((share, flat), batch, textures))
 
     def draw(self, view: View, mode: str = "COMBINED", depth_pull: float = 0.0) -> None:
-        """Draw into the bound framebuffer, depth-tested (LESS_EQUAL) and depth-writing."""
+        """Draw into the bound framebuffer, depth-tested (LESS_EQUAL) and depth-writing, both sides of every
+        triangle: those facing the camera first, in every part, then the others, most of which lie behind the
+        first and then fail the depth test unshaded. (Each triangle is drawn once, by one of the two passes.)"""
         if not self.parts:
             return
         constants = {"u_view_projection": Matrix(np.asarray(view.view_projection, float).tolist()),
                      "u_eye": (*view.eye, 1.0 if view.ortho else 0.0),
                      "u_forward": (*view.forward, float(depth_pull)),
-                     "u_params": (*self.page_heights, *MODES[mode])}
+                     "u_pages": self.page_heights}
         gpu.state.depth_test_set("LESS_EQUAL")
         gpu.state.depth_mask_set(True)
+        for culled in ("BACK", "FRONT"):
+            gpu.state.face_culling_set(culled)
+            for variant, batch, textures in self.parts:
+                shader = surface_shader(*variant, mode)
+                shader.bind()
+                for name, value in constants.items():
+                    shader.uniform_float(name, value)
+                for name, texture in textures.items():
+                    shader.uniform_sampler(name, texture)
+                batch.draw(shader)
         gpu.state.face_culling_set("NONE")
-        for variant, batch, textures in self.parts:
-            shader = surface_shader(variant)
-            shader.bind()
-            for name, value in constants.items():
-                shader.uniform_float(name, value)
-            for name, texture in textures.items():
-                shader.uniform_sampler(name, texture)
-            batch.draw(shader)
         gpu.state.depth_test_set("NONE")
         gpu.state.depth_mask_set(False)
 
