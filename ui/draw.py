@@ -12,8 +12,8 @@ The triangles are drawn in a batch per shader variant (draw_parts.py): those who
 the same from every view (Diffuse BSDF, Principled without a specular layer) skip the per-pixel lookup of the
 share, a fifth of a full-screen redraw on llvmpipe (benchmarks/results/viewport_llvmpipe.md); of the others, those
 whose share a polynomial in μ fits evaluate it instead of sampling the table; triangles with one normal get it
-flat. Each variant is compiled per display mode, when first drawn, and every redraw draws the triangles facing
-the camera before the others.
+flat. Each variant is compiled per display mode, when first drawn, and a redraw of a small mesh draws the
+triangles facing the camera before the others.
 
 Must run where Blender's `gpu` module draws: the main thread of an interactive Blender, or background mode after
 one tiny Workbench render (ensure_gpu).
@@ -50,6 +50,12 @@ SHARE_SAMPLERS = {CONSTANT: (), GREY: (POLY_SAMPLER,), POLY: (POLY_SAMPLER,), TA
 # The polynomial's coefficients, two vec4s a channel, handed on flat: of the red channel alone where all are grey.
 SHARE_OUTPUTS = {CONSTANT: (), GREY: (("v_r0", 4), ("v_r1", 4)), TABLE: (),
                  POLY: tuple((f"v_{c}{k}", 4) for c in "rgb" for k in (0, 1))}
+# Up to this many triangles a redraw draws those facing the camera in a pass before the others, so most back
+# faces fail the depth test unshaded. llvmpipe culls after the vertex shader, so the second pass shades every
+# vertex again: 0.2 ms per 1000 triangles with one core taken, which the saved fragments repay at 960×540 up to
+# about 15 000 (measured, one core taken: −1.5 ms on the furnished room's 830 triangles, −0.6 with a 4 800-triangle
+# sphere added to default_principled, ±0 at 15 500, +1.8 ms at 41 000, +7.8 ms at 95 000).
+FRONT_FIRST_TRIANGLES = 10_000
 _shaders = {}
 
 
@@ -196,8 +202,8 @@ class SurfaceDrawing:
 
     def draw(self, view: View, mode: str = "COMBINED", depth_pull: float = 0.0) -> None:
         """Draw into the bound framebuffer, depth-tested (LESS_EQUAL) and depth-writing, both sides of every
-        triangle: those facing the camera first, in every part, then the others, most of which lie behind the
-        first and then fail the depth test unshaded. (Each triangle is drawn once, by one of the two passes.)"""
+        triangle: up to FRONT_FIRST_TRIANGLES those facing the camera first, in every part, then the others (a
+        pass with back faces culled, then one with front faces culled: each triangle is drawn once)."""
         if not self.parts:
             return
         constants = {"u_view_projection": Matrix(np.asarray(view.view_projection, float).tolist()),
@@ -206,7 +212,7 @@ class SurfaceDrawing:
                      "u_pages": self.page_heights}
         gpu.state.depth_test_set("LESS_EQUAL")
         gpu.state.depth_mask_set(True)
-        for culled in ("BACK", "FRONT"):
+        for culled in ("BACK", "FRONT") if self.triangles <= FRONT_FIRST_TRIANGLES else ("NONE",):
             gpu.state.face_culling_set(culled)
             for variant, batch, textures in self.parts:
                 shader = surface_shader(*variant, mode)
