@@ -16,16 +16,22 @@ def lighting(ctx, programs, gbuffer, states, gvs: list, settings: LpvSettings):
     out = ctx.texture((w, h), 4, dtype="f4")
     receiving = isinstance(states, ReceiverLight)
     flux_mode = not receiving and settings.lookup == "flux" and all(g is not None for g in gvs)
-    mode = {"MODE_RECEIVERS": 1} if receiving else {"MODE_FLUX": 1} if flux_mode else None
+    dense = receiving and gvs[0].light_volumes is not None
+    mode = {"MODE_RECEIVER_VOLUMES": 1} if dense else {"MODE_RECEIVERS": 1} if receiving else \
+        {"MODE_FLUX": 1} if flux_mode else None
+    if dense:
+        states.write_volumes()  # first: it binds image units of its own
     prog = programs.compute("lpv/lighting.glsl", mode)
     out.bind_to_image(0, read=False, write=True)
     unit = bind_named(prog, [("u_position", gbuffer.textures["position"]), ("u_normal", gbuffer.textures["normal"])])
     grids = states.grids if receiving else [s.grid for s in states]
     n = len(grids)
     if receiving:
-        per_cascade = {"u_index": [g.receiver_index for g in gvs]}
-        states.records.bind_to_storage_buffer(6)
-        set_uniform(prog, "u_record_base", list(states.bases) + [0] * (4 - n))
+        if dense:
+            per_cascade = {"u_receiver_light": gvs[0].light_volumes.volumes}
+        else:
+            per_cascade = {"u_index": [g.receiver_index for g in gvs]}
+            states.records.bind_to_storage_buffer(6)
     elif flux_mode:
         per_cascade = {"u_front": [s.front_total for s in states], "u_back": [s.back_total for s in states],
                        "u_voxel_normal": [g.normal for g in gvs]}
@@ -36,7 +42,7 @@ def lighting(ctx, programs, gbuffer, states, gvs: list, settings: LpvSettings):
         set_uniform(prog, "u_fine_origin", fine_origin + [fine_origin[-1]] * (4 - n))
         set_uniform(prog, "u_fine_size", [tuple(g.fine.size) for g in gvs] + [(1, 1, 1)] * (4 - n))
     for name, texs in per_cascade.items():
-        unit = bind_samplers(prog, name, texs, unit, pad_to=4)
+        unit = bind_samplers(prog, name, texs, unit, pad_to=max(4, len(texs)))
     origins = [tuple(float(c) for c in g.origin) for g in grids]
     set_uniform(prog, "u_grid_origin", origins + [origins[-1]] * (4 - n))
     set_uniform(prog, "u_grid_cell", [float(g.cell) for g in grids] + [1.0] * (4 - n))

@@ -42,13 +42,16 @@ class GeometryVolume:
     positions: np.ndarray | None = None  # (R, 3) their area-weighted centroid (m)
     bounds: tuple | None = None  # ((R, 3), (R, 3)) the box their surfaces span (m)
     receivers: object = None  # storage buffer: (R, 4) vec4 each receiver's mean normal and area (m²), centroid, box
-    receiver_index: object = None  # r32i fine voxel texture: 8 × first receiver + mask of its axes (receivers.py)
+    light_volumes: object = None  # receivers.LightVolumes: their irradiance per axis and side, for the lookup
+    receiver_index: object = None  # r32i fine voxel texture: 8 × first receiver + mask of its axes (receivers.py),
+    # where the grid is too large for light_volumes
 
     layers_far: object = None  # per LPV cell (lpv/crossings.py): the far layers where its surfaces form two
 
     def release(self):
         for t in (self.blocking, self.area, self.normal, self.albedo, self.coverage, self.layers, self.surfaces,
-                  self.albedo_back, self.front, self.receivers, self.receiver_index, self.layers_far):
+                  self.albedo_back, self.front, self.receivers, self.light_volumes, self.receiver_index,
+                  self.layers_far):
             if t is not None:
                 t.release()
 

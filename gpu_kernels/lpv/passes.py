@@ -110,16 +110,17 @@ def transfer_estimate(scene, s) -> dict:
 
 def transfer_bytes(scene, s) -> tuple[int, int]:
     """(GPU, host) bytes the cached transport adds at these settings, estimated from the surface area: the GPU's
-    read-back buffer of T's rows (transfer.ROWS_BYTES), the sources and the two irradiance textures per cascade;
-    T itself in host memory (2 × clusters × surface voxels float32)."""
+    read-back buffer of T's rows (transfer.ROWS_BYTES), the sources and the receivers' light volumes (or, too large
+    for those, their sparse index); T itself in host memory (2 × clusters × surface voxels float32)."""
     grids = cascade_grids(scene, s)
     budget = transfer_budget(scene, grids, s)
     if not budget:
         return 0, 0
     voxels = surface_voxels(scene, grids)
-    fine = sum(int(np.prod([2 * n + 2 for n in g.size])) for g in grids)
+    light = sum(v if v <= receivers.LIGHT_VOLUME_BYTES else v // 24  # the index: one int32 per fine voxel
+                for v in (receivers.light_volume_bytes(occlusion.fine_grid(g)) for g in grids))
     rows = min(transfer.ROWS_BYTES, 8 * budget * voxels)
-    gpu = len(grids) * int(rows + budget * gather.VPL_DTYPE.itemsize) + 2 * fine * 16
+    gpu = len(grids) * int(rows + budget * gather.VPL_DTYPE.itemsize) + light
     return gpu, len(grids) * int(8 * budget * voxels)
 
 
@@ -137,7 +138,7 @@ def _transfer(frame, grids, k_grids, maps, k_rsm, budget) -> MethodOutput:
     colours = frame.shadows.buffers.lights["color_type"][:, :3].astype(np.float64)  # (lights, 3)
     k_prop = (k_src, frame.keys["shadow"], keys["albedo_transfer"], keys["gv"], s.max_iterations, s.clamp_negative,
               s.bounces, s.epsilon)
-    solved = cache.run("lpv_propagate", k_prop, lambda: _solve(ctx, gvs, grids, transfers, reflection, [
+    solved = cache.run("lpv_propagate", k_prop, lambda: _solve(ctx, programs, gvs, grids, transfers, reflection, [
         (np.einsum("gck,gk->ck", first, colours), float((lost * colours).sum())) for first, lost in units], s))
     k_light = (frame.keys["gbuffer"], k_prop)
     indirect = cache.run("lpv_lighting", k_light,
@@ -202,7 +203,7 @@ def _build(ctx, programs, gv, grid, budget, s, prior=None) -> transfer.Transfer:
     return transfer.sort_by_cluster(sources, matrix, gv, grid)
 
 
-def _solve(ctx, gvs, grids, transfers, reflection, sources, s) -> dict:
+def _solve(ctx, programs, gvs, grids, transfers, reflection, sources, s) -> dict:
     """Each cascade's bounce series (transfer.solve), uploaded for the flux lookup, and its statistics."""
     sides, stats = [], []
     for gv, grid, t, (m, gain), (first, unbinned) in zip(gvs, grids, transfers, reflection, sources):
@@ -213,4 +214,4 @@ def _solve(ctx, gvs, grids, transfers, reflection, sources, s) -> dict:
                       "transfer_updated": t.updated, "injected_flux": float(first.sum()),
                       "escaped_flux": unbinned,
                       "bounces": [{"flux": f} for f in passes], "bounces_used": len(passes)})
-    return {"surfaces": receivers.upload_light(ctx, grids, gvs, sides), "stats": stats}
+    return {"surfaces": receivers.upload_light(ctx, programs, grids, gvs, sides), "stats": stats}

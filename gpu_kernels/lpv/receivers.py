@@ -15,9 +15,9 @@ cannot tell two surfaces that meet in it apart.
 
 The receivers come from three voxelisations of one fine grid, each of the triangles of one dominant axis
 (voxel/voxelize.py axis_only, positions); the geometry volume's blocking and visibility planes
-(lpv/crossings.py) use their sum. The flux lookup (lpv/lighting.glsl MODE_RECEIVERS) reads them through a sparse
-index per fine voxel: which axes it has receivers for and where its first one is in the light records uploaded after
-each solve.
+(lpv/crossings.py) use their sum. The flux lookup (lpv/lighting.glsl) reads their irradiance from six volumes of the
+fine grid (axis × side) written after each solve, filtered: three fetches per pixel; a grid too large for them
+(LIGHT_VOLUME_BYTES) through a sparse index per fine voxel into the light records instead.
 """
 from __future__ import annotations
 
@@ -92,9 +92,7 @@ def axis_volumes(ctx, programs, scene: Scene, geometry, textures, grids: list) -
         area, normal, surfaces = _combined(arrays)
         r = _receivers(arrays, fine)
         blocking = ctx.texture3d(tuple(n + 1 for n in grid.size), 4, face_blocking(area, grid).tobytes(), dtype="f4")
-        index = ctx.texture3d(tuple(fine.size), 1, receiver_index(r["cells"], r["axis"], fine).tobytes(), dtype="i4")
-        for t in (blocking, index):
-            t.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        blocking.filter = (moderngl.NEAREST, moderngl.NEAREST)
         records = np.zeros((len(r["cells"]), 4), np.int32)
         records[:, :3] = r["cells"]
         oriented = np.zeros((len(r["cells"]), 2, 4), np.float32)  # lpv/gather.glsl MODE_TRANSFER's Receivers
@@ -104,7 +102,13 @@ def axis_volumes(ctx, programs, scene: Scene, geometry, textures, grids: list) -
                             surface_area=r["areas"], surface_albedo=r["albedo"], front=front,
                             **volume_fields(ctx, crossing_layers(area, normal, grid, surfaces)))
         gv.axis, gv.positions, gv.bounds = r["axis"], r["positions"], (r["lo"], r["hi"])
-        gv.receivers, gv.receiver_index = ssbo(ctx, oriented), index
+        gv.receivers = ssbo(ctx, oriented)
+        if light_volume_bytes(fine) <= LIGHT_VOLUME_BYTES:
+            gv.light_volumes = make_light_volumes(ctx, fine, r["cells"], r["axis"])
+        else:
+            gv.receiver_index = ctx.texture3d(tuple(fine.size), 1, receiver_index(r["cells"], r["axis"], fine).tobytes(),
+                                              dtype="i4")
+            gv.receiver_index.filter = (moderngl.NEAREST, moderngl.NEAREST)
         out.append(gv)
     return out
 
@@ -158,30 +162,93 @@ def axis_albedo(ctx, programs, scene: Scene, geometry, textures, gv: GeometryVol
     return out
 
 
+LIGHT_VOLUME_BYTES = 256 * 2 ** 20  # the six dense volumes' budget (a 64-cell grid's fit), else the sparse index
+
+
+def light_volume_bytes(fine: Grid) -> int:
+    """Bytes of LightVolumes for a fine grid: six RGBA32F volumes."""
+    return 6 * 16 * int(np.prod(fine.size))
+
+
 @dataclass
-class ReceiverLight:
-    """What the flux lookup (lpv/lighting.glsl MODE_RECEIVERS) reads: every cascade's receivers' irradiance per side,
-    one storage buffer of (R, 2) vec4 (front, back; a = 1 where it receives), cascade after cascade from `bases`, each
-    in receiver_order, and per cascade its geometry volume (grids, fine voxels and receiver_index textures)."""
-    grids: list
-    gvs: list
-    bases: list
-    records: object
+class LightVolumes:
+    """Six RGBA32F volumes of a geometry volume's fine grid, axis a's side s at 2a + s, that lpv/lighting.glsl
+    (MODE_RECEIVER_VOLUMES) filters: rgb a receiver's irradiance, a = 1 where it receives, zero where there is no
+    receiver. Made zero once per geometry; each solve writes only its receivers' voxels (lpv/receiver_light.glsl),
+    which a dense upload per solve would cost the whole grid's bytes. `cells`: the receivers' voxels and axes, the
+    storage buffer the scatter reads; `holder`: the ReceiverLight whose light they hold now."""
+    volumes: list
+    cells: object
+    holder: object = None
 
     def release(self):
+        for t in self.volumes + [self.cells]:
+            t.release()
+
+
+def make_light_volumes(ctx, fine: Grid, cells: np.ndarray, axis: np.ndarray) -> LightVolumes:
+    import moderngl
+
+    from ..gl.bind import zero_texture
+
+    volumes = []
+    for _ in range(6):
+        t = ctx.texture3d(tuple(int(n) for n in fine.size), 4, None, dtype="f4")
+        zero_texture(ctx, t)
+        t.repeat_x = t.repeat_y = t.repeat_z = False
+        t.filter = (moderngl.LINEAR, moderngl.LINEAR)
+        volumes.append(t)
+    records = np.zeros((len(cells), 4), np.int32)
+    records[:, :3], records[:, 3] = cells, axis
+    return LightVolumes(volumes, ssbo(ctx, records))
+
+
+@dataclass
+class ReceiverLight:
+    """What the flux lookup (lpv/lighting.glsl MODE_RECEIVER_VOLUMES or MODE_RECEIVERS) reads: the cached transport's
+    one cascade's grid and geometry volume, and its receivers' irradiance per side, a storage buffer of (R, 2) vec4
+    (front, back; a = 1 where it receives) in receiver_order — written into the geometry volume's LightVolumes
+    (write_volumes) or read through its sparse receiver_index."""
+    grids: list
+    gvs: list
+    records: object
+    ctx: object = None
+    programs: object = None
+
+    def write_volumes(self) -> None:
+        """Make the geometry volume's LightVolumes hold this light (a no-op where they already do)."""
+        from ..gl.bind import bind_images, dispatch, set_uniform
+
+        light = self.gvs[0].light_volumes
+        if light is None or light.holder is self:
+            return
+        prog = self.programs.compute("lpv/receiver_light.glsl")
+        self.records.bind_to_storage_buffer(6)
+        light.cells.bind_to_storage_buffer(7)
+        bind_images(light.volumes, read=False, write=True)
+        set_uniform(prog, "u_count", int(self.gvs[0].surface_count))
+        dispatch(prog, (max(int(self.gvs[0].surface_count), 1),), local=64)
+        self.ctx.memory_barrier()
+        light.holder = self
+
+    def release(self):
+        light = self.gvs[0].light_volumes
+        if light is not None and light.holder is self:
+            light.holder = None
         self.records.release()
 
 
-def upload_light(ctx, grids: list, gvs: list, sides: list) -> ReceiverLight:
-    """The receivers' irradiance, (2, R, 3) per cascade in `sides`, as one buffer of light records; a receiver with
-    no area or normal receives nothing (a = 0)."""
-    parts, bases, base = [], [], 0
-    for gv, side in zip(gvs, sides):
-        valid = (gv.surface_area > 0) & (np.linalg.norm(gv.surface_normal, axis=1) > 0)
-        records = np.zeros((len(valid), 2, 4), np.float32)
-        records[:, :, :3] = np.where(valid[None, :, None], side, 0.0).transpose(1, 0, 2)
-        records[:, :, 3] = valid[:, None]
-        parts.append(records)
-        bases.append(base)
-        base += len(valid)
-    return ReceiverLight(list(grids), list(gvs), bases, ssbo(ctx, np.concatenate(parts) if parts else np.zeros(4)))
+def upload_light(ctx, programs, grids: list, gvs: list, sides: list) -> ReceiverLight:
+    """The receivers' irradiance, (2, R, 3) per cascade in `sides` (one: the cached transport has no cascades), as a
+    ReceiverLight, written into the LightVolumes where the geometry volume has them; a receiver with no area or
+    normal receives nothing (a = 0)."""
+    if len(gvs) != 1:
+        raise ValueError("the cached transport has one cascade")
+    gv, side = gvs[0], sides[0]
+    valid = (gv.surface_area > 0) & (np.linalg.norm(gv.surface_normal, axis=1) > 0)
+    records = np.zeros((len(valid), 2, 4), np.float32)
+    records[:, :, :3] = np.where(valid[None, :, None], side, 0.0).transpose(1, 0, 2)
+    records[:, :, 3] = valid[:, None]
+    light = ReceiverLight(list(grids), list(gvs), ssbo(ctx, records), ctx, programs)
+    light.write_volumes()
+    return light

@@ -13,6 +13,8 @@ import numpy as np
 import pytest
 
 from bounce_gi.gpu_kernels.engine import Engine
+from bounce_gi.gpu_kernels.gl.bind import read_texture
+from bounce_gi.gpu_kernels.lpv import lighting, receivers
 from bounce_gi.gpu_kernels.lpv.settings import LpvSettings
 from bounce_gi.gpu_kernels.scene import Light, Material, World
 from bounce_gi.gpu_kernels.settings import RenderSettings
@@ -124,6 +126,40 @@ def test_moving_an_object_updates_the_transfer_and_matches_a_render_from_scratch
     cold = Engine().render(room(0.05), SETTINGS)
     assert cold.info["cascades"][0]["block"] == info["block"]
     _same(_indirect(moved), _indirect(cold))
+
+
+def test_the_dense_light_volumes_and_the_sparse_index_look_up_the_same_light(monkeypatch):
+    """The flux lookup filters six dense volumes (MODE_RECEIVER_VOLUMES) where they fit LIGHT_VOLUME_BYTES, else
+    reads a sparse index into the records (MODE_RECEIVERS, coded apart: eight voxels by hand). Same blend, so the
+    same image up to the texture unit's filter weights (float on llvmpipe; 8-bit fixed point on some GPUs, 1/512 of
+    a neighbour's difference): 1e-4 of the image's mean."""
+    dense = Engine().render(_room(), SETTINGS)
+    monkeypatch.setattr(receivers, "LIGHT_VOLUME_BYTES", 0)
+    sparse = Engine().render(_room(), SETTINGS)
+    a, b = _indirect(dense), _indirect(sparse)
+    print("dense vs sparse, max |difference| / mean:", np.abs(a - b).max() / b.mean())
+    assert b.mean() > 0 and np.abs(a - b).max() <= 1e-4 * b.mean()
+
+
+def test_a_lookup_of_an_older_solve_writes_its_own_light_back(warm):
+    """The light volumes belong to the geometry and each solve writes its receivers' light into them; a lookup of a
+    light they no longer hold (another solve wrote since) writes it back first, and gets its own image."""
+    cache = warm.pipeline.cache
+    settings = SETTINGS.lpv
+
+    def run(ctx):
+        light, gbuffer = cache.entries["lpv_propagate"].value["surfaces"], cache.entries["gbuffer"].value
+        programs = warm.pipeline.programs
+        before = read_texture(lighting.lighting(ctx, programs, gbuffer, light, light.gvs, settings), 3)
+        dark = receivers.upload_light(ctx, programs, light.grids, light.gvs,
+                                      [np.zeros((2, light.gvs[0].surface_count, 3), np.float32)])
+        unlit = read_texture(lighting.lighting(ctx, programs, gbuffer, dark, dark.gvs, settings), 3)
+        after = read_texture(lighting.lighting(ctx, programs, gbuffer, light, light.gvs, settings), 3)
+        dark.release()
+        return before, unlit, after
+    before, unlit, after = warm.worker.call(run)
+    assert before.mean() > 0 and unlit.max() == 0
+    assert np.array_equal(before, after)
 
 
 def test_receivers_beside_and_on_an_edge_get_the_closed_box_irradiance():

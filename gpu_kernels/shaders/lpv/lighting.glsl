@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Diffuse Indirect from the LPV. Three estimators of irradiance E at a surface point with normal n:
 //
-// MODE_RECEIVERS (the cached transport, lpv/transfer.py): the irradiance of the receivers near the point, one per
-// voxel and dominant axis of its surfaces (lpv/receivers.py; see receiver_irradiance).
+// MODE_RECEIVER_VOLUMES / MODE_RECEIVERS (the cached transport, lpv/transfer.py): the irradiance of the receivers
+// near the point, one per voxel and dominant axis of its surfaces (lpv/receivers.py; see receiver_irradiance), from
+// six dense volumes or a sparse index.
 //
 // MODE_FLUX (the gathered and propagated transports): the irradiance of the surface voxels near the point, from the
 // flux fuzzy occlusion stopped there (lpv/absorb.glsl) or the gather: energy-exact, since irradiance × area summed
@@ -107,25 +108,48 @@ vec3 flux_irradiance(int cascade, vec3 p, vec3 n) {
     if (agreed_w > 1e-3) return agreed / agreed_w;
     return wsum > 0.0 ? sum / wsum : vec3(0.0);
 }
-#elif defined(MODE_RECEIVERS)
+#elif defined(MODE_RECEIVERS) || defined(MODE_RECEIVER_VOLUMES)
 // The cached transport's receivers (lpv/receivers.py): a voxel's surfaces split by the dominant axis of their
-// normals, each with its front (+axis) and back irradiance. A sparse index per fine voxel says which axes it has
-// receivers for (bits 0–2) and where its first is (the rest, × 8) in the records, one cascade after another.
-uniform isampler3D u_index[MAX_CASCADES];
-uniform int u_record_base[MAX_CASCADES];
+// normals, each with its front (+axis) and back irradiance. One cascade: the cached transport has no others.
+//
+// The eight fine voxels around p are blended trilinearly over those with a receiver (Σ w·E / Σ w); of the axes n
+// leans along, weighted n_a² — the weights of an ambient cube (McTaggart 2004, Valve's Source engine): they sum to
+// one, pick the floor's receiver for a floor however near a wall, and blend a curved surface's across axes — on the
+// side n faces. Where no receiver of n's axes is near (a sliver), any of them. Voxels outside the fine grid count as
+// empty.
 uniform vec3 u_fine_origin[MAX_CASCADES];
 uniform ivec3 u_fine_size[MAX_CASCADES];
-layout(std430, binding = 6) readonly buffer ReceiverLight { vec4 records[]; };  // per receiver: front, back (a = 1)
+#if defined(MODE_RECEIVER_VOLUMES)
+// Six volumes of the fine grid, axis a's side s at 2a + s (receivers.LightVolumes): rgb the irradiance where a
+// receiver is, a = 1 there, 0 elsewhere. Filtered linearly, their rgb and a are the sums above, so three fetches
+// give the blend; clamped at the edge, a voxel beyond it repeats the edge one, which the normalisation cancels
+// (as if it were empty). Premultiplied this way, texture filtering does the work on any GPU.
+uniform sampler3D u_receiver_light[6];
 
-// The eight fine voxels around p, blended trilinearly; in each, the receivers of the axes n leans along, weighted
-// n_a² — the weights of an ambient cube (McTaggart 2004, Valve's Source engine): they sum to one, pick the floor's
-// receiver for a floor however near a wall, and blend a curved surface's across axes — on the side n faces.
-// A voxel whose centre lies more than 0.3 cells behind p holds this surface's back (a roof's sunlit top under its
-// ceiling, marked in both voxels by the conservative voxelisation): skipped. Where no receiver of n's axes is
-// near (a sliver), any of them.
 vec3 receiver_irradiance(int cascade, vec3 p, vec3 n) {
-    float h = 0.5 * u_grid_cell[cascade];
-    vec3 t = (p - u_fine_origin[cascade]) / h - 0.5;
+    vec3 uvw = (p - u_fine_origin[cascade]) / (0.5 * u_grid_cell[cascade] * vec3(u_fine_size[cascade]));
+    vec3 n2 = n * n;
+    vec3 sum = vec3(0.0), any_sum = vec3(0.0);
+    float wsum = 0.0, any_w = 0.0;
+    for (int a = 0; a < 3; ++a) {
+        vec4 e = texture(u_receiver_light[2 * a + (n[a] >= 0.0 ? 0 : 1)], uvw);
+        sum += n2[a] * e.rgb;
+        wsum += n2[a] * e.a;
+        any_sum += e.rgb;
+        any_w += e.a;
+    }
+    if (wsum > 1e-6) return sum / wsum;
+    return any_w > 0.0 ? any_sum / any_w : vec3(0.0);
+}
+#else
+// The same blend from a sparse index per fine voxel (grids whose six volumes would not fit
+// receivers.LIGHT_VOLUME_BYTES): which axes it has receivers for (bits 0–2) and where its first is (the rest, × 8)
+// in the light records, two vec4 per receiver (front, back; a = 1 where it receives).
+uniform isampler3D u_index[MAX_CASCADES];
+layout(std430, binding = 6) readonly buffer ReceiverRecords { vec4 records[]; };
+
+vec3 receiver_irradiance(int cascade, vec3 p, vec3 n) {
+    vec3 t = (p - u_fine_origin[cascade]) / (0.5 * u_grid_cell[cascade]) - 0.5;
     ivec3 base = ivec3(floor(t));
     vec3 f = t - vec3(base);
     vec3 n2 = n * n;
@@ -137,10 +161,8 @@ vec3 receiver_irradiance(int cascade, vec3 p, vec3 n) {
         if (any(lessThan(G, ivec3(0))) || any(greaterThanEqual(G, u_fine_size[cascade]))) continue;
         int entry = texelFetch(u_index[cascade], G, 0).r;
         if ((entry & 7) == 0) continue;
-        vec3 centre = u_fine_origin[cascade] + (vec3(G) + 0.5) * h;
-        if (dot(centre - p, n) < -0.3 * u_grid_cell[cascade]) continue;
         float w = (o.x == 1 ? f.x : 1.0 - f.x) * (o.y == 1 ? f.y : 1.0 - f.y) * (o.z == 1 ? f.z : 1.0 - f.z);
-        int r = u_record_base[cascade] + (entry >> 3);
+        int r = entry >> 3;
         for (int a = 0; a < 3; ++a) {
             if ((entry & (1 << a)) == 0) continue;
             vec4 e = records[2 * r + (n[a] >= 0.0 ? 0 : 1)];
@@ -155,6 +177,7 @@ vec3 receiver_irradiance(int cascade, vec3 p, vec3 n) {
     if (wsum > 1e-6) return sum / wsum;
     return any_w > 0.0 ? any_sum / any_w : vec3(0.0);
 }
+#endif
 #endif
 
 const float PI = 3.14159265358979;
@@ -205,7 +228,7 @@ void main() {
         if (w <= 0.0) continue;
 #if defined(MODE_FLUX)
         irradiance += w * flux_irradiance(i, pos.xyz, n);
-#elif defined(MODE_RECEIVERS)
+#elif defined(MODE_RECEIVERS) || defined(MODE_RECEIVER_VOLUMES)
         irradiance += w * receiver_irradiance(i, pos.xyz, n);
 #else
         irradiance += w * sample_cascade(i, p, n);
