@@ -61,6 +61,7 @@ class VoxelVolumes:
     albedo_back: object = None
     front: object = None     # sides=True, keep_front=True: the front-most image, the caller's to release or reuse
     position: object = None  # positions=True: rgb the surfaces' area-weighted centroid, cells from the voxel's corner
+    # (it and the extents 0 where a voxel is empty, like every volume)
     extent_lo: object = None  # positions=True: rgb the box the surfaces span, likewise
     extent_hi: object = None
 
@@ -277,6 +278,8 @@ def _resolve(ctx, programs, accs, grid, scale_bits, albedo_max, emission_max, si
     prog = programs.compute("voxel/resolve.glsl", defines)
     nx, ny, nz = grid.size
     out = [ctx.texture3d((nx, ny, nz), 4, dtype="f4") for _ in range(len(VOLUME_NAMES) + sides + 3 * positions)]
+    for t in out:  # the resolve stores to occupied voxels only
+        zero_texture(ctx, t)
     names = ["u_acc_area", "u_acc_albedo", "u_acc_normal", "u_acc_emission"] + ["u_acc_albedo_back"] * sides + \
         ["u_acc_position"] * positions
     bind_named(prog, list(zip(names, accs)))

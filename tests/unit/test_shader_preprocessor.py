@@ -280,3 +280,19 @@ def test_load_program_without_stage_blocks(tmp_path, monkeypatch):
 
 def test_default_shader_dir():
     assert sp.SHADER_DIR == Path(sp.__file__).parent.parent / "shaders"
+
+
+def test_every_volume_pass_declares_the_work_group_dispatch_assumes():
+    """gl/bind.dispatch covers a volume with VOLUME_GROUP-sized groups unless told otherwise: a shader that declared
+    another 3D group would leave voxels unvisited (or visit them twice). Every compute layout naming local_size_z
+    declares VOLUME_GROUP."""
+    import re
+
+    from gpu_kernels.gl.bind import VOLUME_GROUP
+
+    root = Path(sp.__file__).resolve().parents[1] / "shaders"
+    layout = re.compile(r"layout\(local_size_x = (\d+), local_size_y = (\d+), local_size_z = (\d+)\) in;")
+    found = [(path.name, tuple(int(v) for v in m.groups())) for path in sorted(root.rglob("*.glsl"))
+             for m in layout.finditer(path.read_text())]
+    assert len(found) >= 10, found  # the volume passes of voxel/, lpv/ and vct/
+    assert all(group == VOLUME_GROUP for _, group in found), found

@@ -8,7 +8,7 @@
 // geometry absorbed, which — propagation conserving flux — is the injected flux minus what left the grid.
 #include "lpv/common.glsl"
 
-layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
+layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;  // gl/bind.VOLUME_GROUP
 layout(std430, binding = 6) readonly buffer FaceFlux { vec4 face_flux[]; };
 uniform sampler3D u_geometry;       // per LPV cell (size + 1): blocked fraction of its lower x/y/z faces
 uniform sampler3D u_voxel_normal;   // fine voxels: mean sign-canonical normal

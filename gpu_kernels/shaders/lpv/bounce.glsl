@@ -4,7 +4,7 @@
 // the same injection as an RSM texel (lpv/inject.glsl), so the next propagation carries the next bounce.
 #include "lpv/fixed.glsl"
 
-layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
+layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;  // gl/bind.VOLUME_GROUP
 uniform sampler3D u_front;          // last pass: irradiance of each fine voxel's front / back side
 uniform sampler3D u_back;
 uniform sampler3D u_voxel_normal;

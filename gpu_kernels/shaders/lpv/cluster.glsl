@@ -8,7 +8,7 @@
 // (normal.w), which the gather uses as the source's extent (lpv/gather.glsl).
 #include "lpv/common.glsl"
 
-layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
+layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;  // gl/bind.VOLUME_GROUP
 #include "common/structs.glsl"
 layout(std430, binding = 6) writeonly buffer VplList { Vpl vpls[]; };
 uniform sampler3D u_front;          // last pass: irradiance of each fine voxel's front / back side

@@ -9,7 +9,7 @@
 // the total flux of every level identical to O_0's (tested). Children beyond an odd-sized level are empty.
 #include "lpv/common.glsl"
 
-layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
+layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;  // gl/bind.VOLUME_GROUP
 uniform sampler3D u_src_r;       // O_{i-1}, after injection (never after propagation: §3.2, a separate step)
 uniform sampler3D u_src_g;
 uniform sampler3D u_src_b;

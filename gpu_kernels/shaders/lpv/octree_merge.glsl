@@ -15,7 +15,7 @@
 #include "lpv/common.glsl"
 
 #define MAX_LEVELS 5
-layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
+layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;  // gl/bind.VOLUME_GROUP
 uniform sampler3D u_level_r[MAX_LEVELS];  // A_i per level (RGB SH)
 uniform sampler3D u_level_g[MAX_LEVELS];
 uniform sampler3D u_level_b[MAX_LEVELS];

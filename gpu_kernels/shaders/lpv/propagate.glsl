@@ -11,7 +11,7 @@
 // once there — the flux its surfaces absorb (see lpv/lighting.glsl, MODE_FLUX).
 #include "lpv/common.glsl"
 
-layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
+layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;  // gl/bind.VOLUME_GROUP
 uniform sampler3D u_src_r;
 uniform sampler3D u_src_g;
 uniform sampler3D u_src_b;

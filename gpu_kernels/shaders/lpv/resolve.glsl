@@ -3,7 +3,7 @@
 // MODE_ADD adds the injected light to what the volumes already hold (used by world light and bounces).
 #include "lpv/common.glsl"
 
-layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
+layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;  // gl/bind.VOLUME_GROUP
 layout(std430, binding = 4) readonly buffer LpvAccum { int accum[]; };
 layout(rgba32f, binding = 0) uniform image3D u_out_r;
 layout(rgba32f, binding = 1) uniform image3D u_out_g;

@@ -3,7 +3,7 @@
 // gathering them, as the last gathered pass's irradiance times u_tail (r = the flux ratio of the next bounce's VPLs
 // to the last one's; common/bounce_tail.glsl).
 #include "common/bounce_tail.glsl"
-layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
+layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;  // gl/bind.VOLUME_GROUP
 layout(rgba32f, binding = 0) uniform readonly image3D u_front;  // the last gathered pass
 layout(rgba32f, binding = 1) uniform readonly image3D u_back;
 layout(rgba32f, binding = 2) uniform image3D u_front_total;

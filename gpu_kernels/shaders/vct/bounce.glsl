@@ -11,7 +11,7 @@
 #include "vct/common.glsl"
 #include "vct/arrays.glsl"
 
-layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
+layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;  // gl/bind.VOLUME_GROUP
 uniform sampler3D u_direct[6];   // vct_inject faces: rgb = L_direct, a = α_g
 uniform sampler3D u_albedo;
 layout(rgba32f, binding = 0) uniform writeonly image3D u_face[6];

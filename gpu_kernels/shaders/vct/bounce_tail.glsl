@@ -3,7 +3,7 @@
 //   L_N = L_K + (L_K − L_(K−1)) · u_tail   (rgb; u_tail from the face flux)
 // in place on L_K; the coverage α is kept. Run once per face direction.
 #include "common/bounce_tail.glsl"
-layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
+layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;  // gl/bind.VOLUME_GROUP
 uniform sampler3D u_previous;                         // this face of L_(K−1)
 layout(rgba32f, binding = 0) uniform image3D u_face;  // this face of L_K, extrapolated in place
 uniform ivec3 u_grid_size;

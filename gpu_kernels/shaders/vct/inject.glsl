@@ -16,7 +16,7 @@
 // a closed emitter traps inside itself (u_exclude_trapped, common/emitters.py): it would leak out of the voxels.
 // MODE_CLEAR zeroes the accumulator; MODE_RESOLVE writes the faces: rgb = L_g, a = α_g, and centroids: xyz = c_g,
 // w = α_g (or the face centre and w = −α_g for a fallback face; w = 0 where the voxel has no surface).
-layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
+layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;  // gl/bind.VOLUME_GROUP
 uniform ivec3 u_grid_size;
 
 #if defined(MODE_CLEAR)

@@ -72,7 +72,7 @@ void main() {
     rows[2 * row + 1] = vec4(missed, 0.0, 0.0, 0.0);
 }
 #elif defined(MODE_READ)
-layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
+layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;  // gl/bind.VOLUME_GROUP
 uniform sampler3D u_src[1];
 layout(std430, binding = 0) writeonly buffer Out { vec4 texels[]; };
 void main() {
@@ -81,7 +81,7 @@ void main() {
     texels[(v.z * u_dst_size.y + v.y) * u_dst_size.x + v.x] = texelFetch(u_src[0], v, u_level);
 }
 #elif defined(MODE_LAYERS)
-layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
+layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;  // gl/bind.VOLUME_GROUP
 uniform sampler3D u_src[6];       // the six direction volumes, every level built
 uniform sampler3D u_centroid[6];  // level 0: vct_inject's centroids (xyz world, w = ±α_g, < 0 for a fallback face)
 uniform sampler3D u_layers_src;   // this volume, read at level u_level − 1
@@ -120,7 +120,7 @@ void main() {
     imageStore(u_layers_dst, v, vec4(out_, 0.0));
 }
 #else
-layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
+layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;  // gl/bind.VOLUME_GROUP
 #define TAU_MAX 6.907755279   // −ln(1e-3) = −ln(MIN_TRANSMITTANCE) of vct/common.glsl
 
 float depth_of(float alpha) { return min(-log(max(1.0 - alpha, 1e-30)), TAU_MAX); }

@@ -10,7 +10,7 @@
 //   with POSITIONS, position rgb = Σ A·(centroid − voxel min corner) / Σ A, in cells, and extent_lo / extent_hi
 //   the box the surfaces span, likewise
 // Pure integer→float arithmetic per voxel: deterministic.
-layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
+layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;  // gl/bind.VOLUME_GROUP
 uniform ivec3 u_grid_size;
 
 #if defined(MODE_RESOLVE)
@@ -37,8 +37,8 @@ vec3 side_albedo(uvec4 acc) {
 #endif
 #if defined(POSITIONS)
 uniform usampler3D u_acc_position;
-// rgb: the surfaces' area-weighted centroid, in cells from the voxel's min corner (0.5: its centre where empty);
-// extent_lo / extent_hi rgb: the box the surfaces span, likewise
+// rgb: the surfaces' area-weighted centroid, in cells from the voxel's min corner; extent_lo / extent_hi rgb: the
+// box the surfaces span, likewise (all 0 where empty, like every volume)
 layout(binding = 5, rgba32f) uniform writeonly image3D u_position;
 layout(binding = 6, rgba32f) uniform writeonly image3D u_extent_lo;
 layout(binding = 7, rgba32f) uniform writeonly image3D u_extent_hi;
@@ -53,27 +53,25 @@ uvec4 fetch(usampler3D s, ivec3 v) {
 void main() {
     ivec3 v = ivec3(gl_GlobalInvocationID);
     if (any(greaterThanEqual(v, u_grid_size))) return;
-    vec4 area_m2 = vec4(0.0), albedo = vec4(0.0), normal = vec4(0.0), emission = vec4(0.0), back = vec4(0.0);
-    vec4 position = vec4(0.5, 0.5, 0.5, 0.0), extent_lo = vec4(0.0), extent_hi = vec4(1.0, 1.0, 1.0, 0.0);
-    uint total = texelFetch(u_acc_area, ivec3(4 * v.x + 3, v.y, v.z), 0).r;
-    if (total > 0u) {   // most voxels are empty: one fetch decides
-        uvec4 area = fetch(u_acc_area, v);
-        area_m2 = vec4(area) * u_unit_area;
-        float inv = 1.0 / float(area.w);   // the fixed-point unit cancels in every mean
-        albedo.rgb = vec3(fetch(u_acc_albedo, v).rgb) * (inv * u_albedo_max);
-        albedo.a = min(1.0, max(max(area_m2.x, area_m2.y), area_m2.z) / u_cell_area);
-        normal.xyz = vec3(ivec3(fetch(u_acc_normal, v).xyz)) * (2.0 * inv);
-        emission.rgb = vec3(fetch(u_acc_emission, v).rgb) * (inv * u_emission_max);
+    // Most voxels are empty: one fetch decides, and an empty one keeps the zeros its volumes were made with
+    // (voxelize._resolve: llvmpipe's image stores are slow, and most of the grid would store zeros).
+    if (texelFetch(u_acc_area, ivec3(4 * v.x + 3, v.y, v.z), 0).r == 0u) return;
+    uvec4 area = fetch(u_acc_area, v);
+    vec4 area_m2 = vec4(area) * u_unit_area;
+    float inv = 1.0 / float(area.w);   // the fixed-point unit cancels in every mean
+    vec4 albedo = vec4(vec3(fetch(u_acc_albedo, v).rgb) * (inv * u_albedo_max),
+                       min(1.0, max(max(area_m2.x, area_m2.y), area_m2.z) / u_cell_area));
+    vec4 normal = vec4(vec3(ivec3(fetch(u_acc_normal, v).xyz)) * (2.0 * inv), 0.0);
+    vec4 emission = vec4(vec3(fetch(u_acc_emission, v).rgb) * (inv * u_emission_max), 0.0);
 #if defined(SIDES)
-        albedo.rgb = side_albedo(fetch(u_acc_albedo, v));
-        back = vec4(side_albedo(fetch(u_acc_albedo_back, v)), albedo.a);
+    albedo.rgb = side_albedo(fetch(u_acc_albedo, v));
+    vec4 back = vec4(side_albedo(fetch(u_acc_albedo_back, v)), albedo.a);
 #endif
 #if defined(POSITIONS)
-        position.xyz = vec3(fetch(u_acc_position, v).xyz) * inv;
-        extent_lo.xyz = 1.0 - vec3(fetch(u_acc_position, v + ivec3(0, u_grid_size.y, 0)).xyz) / 65535.0;
-        extent_hi.xyz = vec3(fetch(u_acc_position, v + ivec3(0, 2 * u_grid_size.y, 0)).xyz) / 65535.0;
+    vec4 position = vec4(vec3(fetch(u_acc_position, v).xyz) * inv, 0.0);
+    vec4 extent_lo = vec4(1.0 - vec3(fetch(u_acc_position, v + ivec3(0, u_grid_size.y, 0)).xyz) / 65535.0, 0.0);
+    vec4 extent_hi = vec4(vec3(fetch(u_acc_position, v + ivec3(0, 2 * u_grid_size.y, 0)).xyz) / 65535.0, 0.0);
 #endif
-    }
     imageStore(u_area, v, area_m2);
     imageStore(u_albedo, v, albedo);
     imageStore(u_normal, v, normal);
