@@ -53,25 +53,23 @@ def crossing_layers(area: np.ndarray, normal: np.ndarray, grid: Grid, surfaces: 
     far share, near layer); axis cells: coverage (per axis covered share, box_code), layers (per axis near layer, end),
     layers_far (per axis far layer). The end is negative where a direction has two layers; empty cells are zero.
     From fine voxel arrays `area` (rgb projected areas, a total) and `normal`. LPV cell c holds fine voxels
-    [2c + 1, 2c + 3) along each axis."""
-    nx, ny, nz = grid.size
-    inner = (slice(1, 2 * nz + 1), slice(1, 2 * ny + 1), slice(1, 2 * nx + 1))
-    weights = area[inner].astype(np.float64)  # per direction: the axes' projected areas, then the total
-    n = normal[inner][..., :3].astype(np.float64)
+    [2c + 1, 2c + 3) along each axis; only the cells holding a surface are worked on (a room's are a fifth)."""
+    cells = _Cells.of(area, grid)
+    weights = cells.gather(area).astype(np.float64)  # per direction: the axes' projected areas, then the total
+    n = cells.gather(normal)[..., :3].astype(np.float64)
     n /= np.maximum(np.linalg.norm(n, axis=-1, keepdims=True), 1e-30)
-    zz, yy, xx = np.meshgrid(*[np.arange(1, 2 * k + 1) / 2 - 0.5 for k in (nz, ny, nx)], indexing="ij")
-    corner = np.stack([xx, yy, zz], axis=-1)  # per fine voxel: its min corner, in cells
+    corner = cells.corners()  # per fine voxel: its min corner, in cells
     if surfaces is None:
         centre = axis_at = corner + 0.25
     else:
-        centre = corner + surfaces.centroid[inner] / 2
-        axis_at = np.where(np.isnan(surfaces.axis_centroid[inner]), centre, corner + surfaces.axis_centroid[inner] / 2)
-    cells = _Cells(nz, ny, nx)
+        centre = corner + cells.gather(surfaces.centroid) / 2
+        own = cells.gather(surfaces.axis_centroid)
+        axis_at = np.where(np.isnan(own), centre, corner + own / 2)
     tensor = cells.sum(weights[..., 3, None, None] * n[..., :, None] * n[..., None, :])
     eigval, eigvec = np.linalg.eigh(tensor)  # ascending
     planar = (cells.sum(weights[..., 3]) > 0) & (eigval[..., 2] >= PLANAR * np.maximum(eigval.sum(axis=-1), 1e-30))
     plane_n = eigvec[..., :, 2]
-    coords = np.concatenate([axis_at, np.einsum("zyxi,zyxi->zyx", centre, cells.up(plane_n))[..., None]], -1)
+    coords = np.concatenate([axis_at, (centre * cells.up(plane_n)).sum(axis=-1)[..., None]], -1)
     cov, near, far, end, spread = (np.stack(v, axis=-1) for v in zip(*[
         _layers(weights[..., d], coords[..., d], grid.cell ** 2, cells, surfaces is not None) for d in range(4)]))
     # an axis cell whose every layer is flat holds planes that meet (a floor and a wall), not a curve cut into planes
@@ -81,27 +79,55 @@ def crossing_layers(area: np.ndarray, normal: np.ndarray, grid: Grid, surfaces: 
         flat[:] = False
         box = None
     else:
-        lo, hi = (corner + getattr(surfaces, k)[inner] / 2 for k in ("lo", "hi"))
+        lo, hi = (corner + cells.gather(getattr(surfaces, k)) / 2 for k in ("lo", "hi"))
         occupied = (weights[..., 3:] > 0)
-        box = (cells.reduce(np.where(occupied, lo, np.inf), "min"), cells.reduce(np.where(occupied, hi, -np.inf), "max"))
-    return _pack(planar, plane_n, cov, near, far, end, flat, surfaces is not None, box)
+        box = (cells.reduce(np.where(occupied, lo, np.inf), "min"), cells.reduce(np.where(occupied, hi, -np.inf), "max"),
+               cells.index)
+    return {k: cells.scatter(v) for k, v in _pack(planar, plane_n, cov, near, far, end, flat, surfaces is not None,
+                                                  box).items()}
 
 
 @dataclass
 class _Cells:
-    """Fine voxel arrays (2nz, 2ny, 2nx, …) per LPV cell (nz, ny, nx, …) and back."""
-    nz: int
-    ny: int
-    nx: int
+    """The LPV cells holding a surface (M of them, `index` (M, 3) xyz) and their eight fine voxels each: arrays
+    (M, 8, …) per fine voxel, (M, …) per cell."""
+    shape: tuple  # (nz, ny, nx)
+    index: np.ndarray
+    flat: np.ndarray  # (M,) their index in the dense (nz, ny, nx) grid
+
+    @staticmethod
+    def of(area: np.ndarray, grid: Grid) -> "_Cells":
+        nx, ny, nz = grid.size
+        total = area[1:2 * nz + 1, 1:2 * ny + 1, 1:2 * nx + 1, 3].reshape(nz, 2, ny, 2, nx, 2).sum(axis=(1, 3, 5))
+        z, y, x = np.nonzero(total > 0)
+        return _Cells((nz, ny, nx), np.stack([x, y, z], axis=-1), np.ravel_multi_index((z, y, x), (nz, ny, nx)))
+
+    def gather(self, fine: np.ndarray) -> np.ndarray:
+        """(M, 8, …) of a fine voxel array (2nz + 2, 2ny + 2, 2nx + 2, …): each cell's voxels in (z, y, x) order."""
+        nz, ny, nx = self.shape
+        inner = fine[1:2 * nz + 1, 1:2 * ny + 1, 1:2 * nx + 1].reshape(nz, 2, ny, 2, nx, 2, *fine.shape[3:])
+        x, y, z = self.index.T
+        return inner[z, :, y, :, x].reshape(len(self.flat), 8, *fine.shape[3:])
+
+    def corners(self) -> np.ndarray:
+        """(M, 8, 3): each fine voxel's min corner, in cells from the grid origin (xyz)."""
+        d = np.stack(np.meshgrid([0, 1], [0, 1], [0, 1], indexing="ij"), -1).reshape(8, 3)[:, ::-1]  # (z, y, x)
+        return self.index[:, None, :] + d[None] / 2.0
 
     def reduce(self, values, how):
-        return getattr(values.reshape(self.nz, 2, self.ny, 2, self.nx, 2, *values.shape[3:]), how)(axis=(1, 3, 5))
+        return getattr(values, how)(axis=1)
 
     def sum(self, values):
         return self.reduce(values, "sum")
 
     def up(self, values):  # per cell → per fine voxel
-        return np.repeat(np.repeat(np.repeat(values, 2, axis=0), 2, axis=1), 2, axis=2)
+        return values[:, None]
+
+    def scatter(self, values: np.ndarray) -> np.ndarray:
+        """Per cell (M, …) → the dense (nz, ny, nx, …) grid, zero where no surface is."""
+        out = np.zeros((int(np.prod(self.shape)),) + values.shape[1:], values.dtype)
+        out[self.flat] = values
+        return out.reshape(self.shape + values.shape[1:])
 
 
 def _layers(weight, coord, cell_area, cells: _Cells, known: bool):
@@ -126,12 +152,11 @@ def _layers(weight, coord, cell_area, cells: _Cells, known: bool):
     return cover, np.where(two, lo, mean), np.where(two, hi, mean), end, np.where(two, 0.0, spread)
 
 
-def box_code(box_lo: np.ndarray, box_hi: np.ndarray) -> np.ndarray:
+def box_code(box_lo: np.ndarray, box_hi: np.ndarray, base: np.ndarray) -> np.ndarray:
     """The box (cells from the grid origin) a cell's surfaces span, in 1/16 of the cell, as one integer per cell
     (exact in float32): 1 + lo_x + 16 lo_y + 16² lo_z + 16³ hi_x + 16⁴ hi_y + 16⁵ hi_z, hi the last sixteenth it
-    reaches into; 0 without a box (the whole cell). Rounded outwards, so the box holds every surface."""
-    nz, ny, nx = box_lo.shape[:3]
-    base = np.stack(np.meshgrid(np.arange(nx), np.arange(ny), np.arange(nz), indexing="xy"), -1).transpose(2, 0, 1, 3)
+    reaches into; 0 without a box (the whole cell). Rounded outwards, so the box holds every surface. `base`: the
+    cells' xyz."""
     with np.errstate(invalid="ignore"):
         lo = np.clip(np.floor((box_lo - base) * 16), 0, 15)
         hi = np.clip(np.ceil((box_hi - base) * 16) - 1, 0, 15)
