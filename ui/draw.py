@@ -112,6 +112,22 @@ def surface_shader(share: str = TABLE, flat: bool = False, mode: str = "COMBINED
     return _shaders[key]
 
 
+def shaders_to_compile(drawing) -> list:
+    """The (share, flat, mode) variants `drawing` would draw in some display mode that are not compiled yet."""
+    variants = dict.fromkeys(variant for variant, _, _ in getattr(drawing, "parts", ()))
+    return [(*variant, mode) for variant in variants for mode in MODES if (*variant, mode) not in _shaders]
+
+
+def compile_next_shader(drawing) -> bool:
+    """Compile one variant `drawing` may need (shaders_to_compile); whether any is left. Called from a timer after
+    a result is shown, one a tick, so that switching the display mode later draws at once: compiling a variant
+    when first drawn stalled the first switch to Direct or Indirect by ~0.1 s on llvmpipe."""
+    missing = shaders_to_compile(drawing)
+    if missing:
+        surface_shader(*missing[0])
+    return len(missing) > 1
+
+
 def release_shader() -> None:
     """Forget the compiled shaders (on unregister: a re-enabled extension compiles its own)."""
     _shaders.clear()

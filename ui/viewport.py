@@ -21,6 +21,7 @@ from .preview import PreviewError, one_line, render_settings_of
 
 # Extraction's resolution: the viewport has its own size, and nothing view-independent depends on this one.
 EXTRACT_RESOLUTION = (64, 64)
+SHADER_TICK_SECONDS = 0.05  # between compiling the display modes' shaders after a result is shown
 FEEDS = []  # every open ViewportFeed (Rendered 3D views, the overlay), newest last: the panel shows the newest
 
 
@@ -107,6 +108,8 @@ class ViewportFeed:
 
     def _tick(self):
         delay = self.session.poll()
+        if delay is None and draw.compile_next_shader(self.session.drawing):
+            delay = SHADER_TICK_SECONDS  # the other display modes' shaders, one a tick, while the user looks
         if delay is None:
             self._timer_on = False
         return delay

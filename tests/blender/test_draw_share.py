@@ -53,3 +53,48 @@ def test_the_fitted_share_draws_what_the_table_draws(tmp_path):
     # less than that again. So no pixel may differ by more than 2e-3. Over the image: the default Principled's fit
     # is within 1.7e-4 of its row, a share near 0.9, so rel-L1 at most 2e-4 (measured: max 1.5e-4, rel-L1 4.7e-5).
     assert float(result[2]) <= 2e-3 and float(result[4]) <= 2e-4, result
+
+
+WARM = """
+import time
+import bpy
+from examples import scenes
+from bounce_gi.addon.extract import extract_scene
+from bounce_gi.gpu_kernels.engine import get_engine
+from bounce_gi.gpu_kernels.settings import RenderSettings
+from bounce_gi.ui import draw
+
+scenes.build("furnished")
+scene = extract_scene(bpy.context.evaluated_depsgraph_get(), (160, 120))
+light = get_engine().submit_surface(scene, RenderSettings(method="none", width=160, height=120), 16384).result()
+draw.ensure_gpu()
+drawing = draw.SurfaceDrawing(light)
+first = draw.shaders_to_compile(drawing)
+ticks, times = 0, []
+while True:
+    start = time.perf_counter()
+    more = draw.compile_next_shader(drawing)
+    times.append(time.perf_counter() - start)
+    ticks += 1
+    if not more or ticks > 100:
+        break
+print("RESULT", len(first), ticks, len(draw.shaders_to_compile(drawing)), max(times))
+"""
+
+
+def test_the_display_modes_shaders_are_compiled_one_a_tick_ahead_of_a_switch(tmp_path):
+    """After a result is shown, the viewport's timer compiles, one a tick, every shader variant its parts would
+    need in any display mode (ui/draw.compile_next_shader), so a later switch of mode draws at once. On the
+    furnished room (its parts: several variants) every variant of the three modes gets compiled, one per call,
+    and the last call says nothing is left."""
+    code = textwrap.dedent(WARM)
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path), ROOT])}
+    os.symlink(ROOT, tmp_path / "bounce_gi")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600, cwd=ROOT,
+                          env=env)
+    assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
+    result = next(line for line in proc.stdout.splitlines() if line.startswith("RESULT")).split()
+    print("variants to compile, calls, left, longest call (s):", result[1:])
+    first, ticks, left = (int(v) for v in result[1:4])
+    assert first >= 6 and first % 3 == 0  # two variants or more, each in the three display modes
+    assert ticks == first and left == 0
