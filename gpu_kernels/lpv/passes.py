@@ -117,8 +117,7 @@ def transfer_bytes(scene, s) -> tuple[int, int]:
     if not budget:
         return 0, 0
     voxels = surface_voxels(scene, grids)
-    light = sum(v if v <= receivers.LIGHT_VOLUME_BYTES else v // 24  # the index: one int32 per fine voxel
-                for v in (receivers.light_volume_bytes(occlusion.fine_grid(g)) for g in grids))
+    light = sum(receivers.lookup_bytes(occlusion.fine_grid(g)) for g in grids)
     rows = min(transfer.ROWS_BYTES, 8 * budget * voxels)
     gpu = len(grids) * int(rows + budget * gather.VPL_DTYPE.itemsize) + light
     return gpu, len(grids) * int(8 * budget * voxels)

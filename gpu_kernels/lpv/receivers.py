@@ -74,6 +74,15 @@ def receiver_index(cells: np.ndarray, axis: np.ndarray, fine: Grid) -> np.ndarra
     return out.astype(np.int32)
 
 
+def _index_texture(ctx, cells: np.ndarray, axis: np.ndarray, fine: Grid):
+    """receiver_index as an r32i fine-grid texture, read nearest."""
+    import moderngl
+
+    t = ctx.texture3d(tuple(fine.size), 1, receiver_index(cells, axis, fine).tobytes(), dtype="i4")
+    t.filter = (moderngl.NEAREST, moderngl.NEAREST)
+    return t
+
+
 def axis_volumes(ctx, programs, scene: Scene, geometry, textures, grids: list) -> list:
     """Geometry volumes (occlusion.GeometryVolume) whose surface voxels are receivers per dominant axis: the
     blocking and visibility planes from all surfaces, the receivers' normals, areas and albedo per axis."""
@@ -97,19 +106,15 @@ def axis_volumes(ctx, programs, scene: Scene, geometry, textures, grids: list) -
         records[:, :3] = r["cells"]
         oriented = np.zeros((len(r["cells"]), 2, 4), np.float32)  # lpv/gather.glsl MODE_TRANSFER's Receivers
         oriented[:, 0, :3], oriented[:, 0, 3], oriented[:, 1, :3] = r["normals"], r["areas"], r["positions"]
-        gv = GeometryVolume(blocking, fine, None, None, None, surfaces=ssbo(ctx, records),
-                            surface_count=len(r["cells"]), cells=r["cells"], surface_normal=r["normals"],
-                            surface_area=r["areas"], surface_albedo=r["albedo"], front=front,
-                            **volume_fields(ctx, crossing_layers(area, normal, grid, surfaces)))
-        gv.axis, gv.positions, gv.bounds = r["axis"], r["positions"], (r["lo"], r["hi"])
-        gv.receivers = ssbo(ctx, oriented)
-        if light_volume_bytes(fine) <= LIGHT_VOLUME_BYTES:
-            gv.light_volumes = make_light_volumes(ctx, fine, r["cells"], r["axis"])
-        else:
-            gv.receiver_index = ctx.texture3d(tuple(fine.size), 1, receiver_index(r["cells"], r["axis"], fine).tobytes(),
-                                              dtype="i4")
-            gv.receiver_index.filter = (moderngl.NEAREST, moderngl.NEAREST)
-        out.append(gv)
+        dense = light_volume_bytes(fine) <= LIGHT_VOLUME_BYTES
+        out.append(GeometryVolume(
+            blocking, fine, None, None, None, surfaces=ssbo(ctx, records), surface_count=len(r["cells"]),
+            cells=r["cells"], surface_normal=r["normals"], surface_area=r["areas"], surface_albedo=r["albedo"],
+            front=front, axis=r["axis"], positions=r["positions"], bounds=(r["lo"], r["hi"]),
+            receivers=ssbo(ctx, oriented),
+            light_volumes=make_light_volumes(ctx, fine, r["cells"], r["axis"]) if dense else None,
+            receiver_index=None if dense else _index_texture(ctx, r["cells"], r["axis"], fine),
+            **volume_fields(ctx, crossing_layers(area, normal, grid, surfaces))))
     return out
 
 
@@ -170,6 +175,13 @@ def light_volume_bytes(fine: Grid) -> int:
     return 6 * 16 * int(np.prod(fine.size))
 
 
+def lookup_bytes(fine: Grid) -> int:
+    """GPU bytes the flux lookup reads of a fine grid: LightVolumes where they fit LIGHT_VOLUME_BYTES, else the
+    receiver_index texture (one int32 a voxel)."""
+    dense = light_volume_bytes(fine)
+    return dense if dense <= LIGHT_VOLUME_BYTES else 4 * int(np.prod(fine.size))
+
+
 @dataclass
 class LightVolumes:
     """Six RGBA32F volumes of a geometry volume's fine grid, axis a's side s at 2a + s, that lpv/lighting.glsl
@@ -189,15 +201,11 @@ class LightVolumes:
 def make_light_volumes(ctx, fine: Grid, cells: np.ndarray, axis: np.ndarray) -> LightVolumes:
     import moderngl
 
-    from ..gl.bind import zero_texture
+    from ..gl.bind import texture3d
 
-    volumes = []
-    for _ in range(6):
-        t = ctx.texture3d(tuple(int(n) for n in fine.size), 4, None, dtype="f4")
-        zero_texture(ctx, t)
-        t.repeat_x = t.repeat_y = t.repeat_z = False
+    volumes = [texture3d(ctx, fine.size, zero=True) for _ in range(6)]
+    for t in volumes:
         t.filter = (moderngl.LINEAR, moderngl.LINEAR)
-        volumes.append(t)
     records = np.zeros((len(cells), 4), np.int32)
     records[:, :3], records[:, 3] = cells, axis
     return LightVolumes(volumes, ssbo(ctx, records))

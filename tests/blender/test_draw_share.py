@@ -35,13 +35,18 @@ print(f"RESULT max {diff.max():.2e} rel-L1 {diff.sum() / np.abs(images['table'])
 """
 
 
-def test_the_fitted_share_draws_what_the_table_draws(tmp_path):
-    code = textwrap.dedent(CASE)
+def _run(case: str, tmp_path):
+    """`case` in a fresh background-bpy process with the repository importable as bounce_gi; it must exit 0."""
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path), ROOT])}
     os.symlink(ROOT, tmp_path / "bounce_gi")
-    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600, cwd=ROOT,
-                          env=env)
+    proc = subprocess.run([sys.executable, "-c", textwrap.dedent(case)], capture_output=True, text=True,
+                          timeout=600, cwd=ROOT, env=env)
     assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
+    return proc
+
+
+def test_the_fitted_share_draws_what_the_table_draws(tmp_path):
+    proc = _run(CASE, tmp_path)
     lines = proc.stdout.splitlines()
     drawn = {line.split()[0]: line for line in lines if line.split()[:1] in (["poly"], ["table"])}
     # Every Principled part fits, with one polynomial for its three channels (no coat tint) ...
@@ -87,12 +92,7 @@ def test_the_display_modes_shaders_are_compiled_one_a_tick_ahead_of_a_switch(tmp
     need in any display mode (ui/draw.compile_next_shader), so a later switch of mode draws at once. On the
     furnished room (its parts: several variants) every variant of the three modes gets compiled, one per call,
     and the last call says nothing is left."""
-    code = textwrap.dedent(WARM)
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path), ROOT])}
-    os.symlink(ROOT, tmp_path / "bounce_gi")
-    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600, cwd=ROOT,
-                          env=env)
-    assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
+    proc = _run(WARM, tmp_path)
     result = next(line for line in proc.stdout.splitlines() if line.startswith("RESULT")).split()
     print("variants to compile, calls, left, longest call (s):", result[1:])
     first, ticks, left = (int(v) for v in result[1:4])
