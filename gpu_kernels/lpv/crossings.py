@@ -34,6 +34,9 @@ END_CELLS = 0.5  # cells: an end's own crossing, surfaces known only to their vo
 END_SLACK = 0.05  # cells: an end's own crossing, surfaces where they lie
 FLAT = 0.05  # cells: a layer whose surfaces spread less than this along its axis is a plane
 FIELDS = ("coverage", "layers", "layers_far")
+# The largest distance to a surface stored in an empty cell (mark_empty_space): a ray skips at most this many
+# cells less one at a time; larger gains little (a room's interior is rarely further from a wall).
+SKIP_CELLS = 16
 
 
 @dataclass
@@ -51,7 +54,8 @@ def crossing_layers(area: np.ndarray, normal: np.ndarray, grid: Grid, surfaces: 
     """FIELDS → (nz, ny, nx, 4) float32 arrays, in cells from the grid origin, packed for lpv/gather.glsl (two fetches
     a cell, a third where an axis has two layers). Plane cells: coverage (n, −covered share), layers (far layer, end,
     far share, near layer); axis cells: coverage (per axis covered share, box_code), layers (per axis near layer, end),
-    layers_far (per axis far layer). The end is negative where a direction has two layers; empty cells are zero.
+    layers_far (per axis far layer). The end is negative where a direction has two layers; empty cells are zero
+    but for coverage's w, their distance to the nearest surface's cell (mark_empty_space).
     From fine voxel arrays `area` (rgb projected areas, a total) and `normal`. LPV cell c holds fine voxels
     [2c + 1, 2c + 3) along each axis; only the cells holding a surface are worked on (a room's are a fifth)."""
     cells = _Cells.of(area, grid)
@@ -83,8 +87,38 @@ def crossing_layers(area: np.ndarray, normal: np.ndarray, grid: Grid, surfaces: 
         occupied = (weights[..., 3:] > 0)
         box = (cells.reduce(np.where(occupied, lo, np.inf), "min"), cells.reduce(np.where(occupied, hi, -np.inf), "max"),
                cells.index)
-    return {k: cells.scatter(v) for k, v in _pack(planar, plane_n, cov, near, far, end, flat, surfaces is not None,
-                                                  box).items()}
+    out = {k: cells.scatter(v) for k, v in _pack(planar, plane_n, cov, near, far, end, flat, surfaces is not None,
+                                                 box).items()}
+    mark_empty_space(out["coverage"])
+    return out
+
+
+def mark_empty_space(coverage: np.ndarray) -> None:
+    """In place: the w of each cell lpv/gather.glsl finds empty (no plane, no axis coverage) set to its Chebyshev
+    distance to the nearest cell that is not (empty_distance), so that a ray there may skip the cells within
+    distance − 1, which are all empty too (Cohen and Sheffer 1994, "Proximity clouds": empty-space skipping by a
+    distance map). Empty cells' w is free: plane cells' is negative, axis cells' holds their box_code."""
+    occupied = (coverage[..., 3] < 0) | (coverage[..., :3] > 0).any(axis=-1)
+    coverage[..., 3] = np.where(occupied, coverage[..., 3], empty_distance(occupied))
+
+
+def empty_distance(occupied: np.ndarray, cap: int = SKIP_CELLS) -> np.ndarray:
+    """Per cell of a (nz, ny, nx) mask: the Chebyshev (L∞) distance in cells to the nearest True cell, 0 on those,
+    at most `cap` (also where there is none), float32. By repeated one-cell dilations (each separable per axis)."""
+    d = np.full(occupied.shape, float(cap), np.float32)
+    reached = occupied.copy()
+    d[reached] = 0.0
+    for k in range(1, cap):
+        if reached.all() or not reached.any():
+            break
+        grown = reached.copy()
+        for axis in range(3):
+            before, view = np.moveaxis(grown.copy(), axis, 0), np.moveaxis(grown, axis, 0)
+            view[1:] |= before[:-1]
+            view[:-1] |= before[1:]
+        d[grown & ~reached] = float(k)
+        reached = grown
+    return d
 
 
 @dataclass

@@ -102,6 +102,22 @@ def _receivers(cells, axis, normals, areas) -> np.ndarray:
     return np.concatenate([cells.astype(np.float64), axis[:, None], normals, areas[:, None]], axis=1)
 
 
+def _match_receivers(old: np.ndarray, new: np.ndarray) -> np.ndarray:
+    """_match for _receivers rows, vectorised: a receiver is one (voxel, axis), so rows are paired by that key
+    (sorted search) and then kept only where the whole row (normal, area) is equal."""
+    def key(rows):
+        c = rows[:, :4].astype(np.int64)
+        return ((c[:, 2] * (1 << 20) + c[:, 1]) * (1 << 20) + c[:, 0]) * 4 + c[:, 3]
+    old_key, new_key = key(old), key(new)
+    order = np.argsort(old_key, kind="stable")
+    at = np.minimum(np.searchsorted(old_key[order], new_key), max(len(old) - 1, 0))
+    if len(old) == 0:
+        return np.full(len(new), -1, np.int64)
+    index = order[at]
+    same = (old_key[index] == new_key) & (old[index] == new).all(axis=1)
+    return np.where(same, index, -1)
+
+
 def changed_box(moved: np.ndarray, fine: Grid, grid: Grid):
     """The box (2, 3) around the fine voxels `moved` (cells that appeared, vanished, or got another normal or
     area), grown by an LPV cell (a cell's visibility planes come from the voxels in it); None when none did."""
@@ -121,21 +137,22 @@ def update_transfer(ctx, programs, gv, grid: Grid, occlusion: bool, prior) -> tu
                         positions=gv.positions, bounds=gv.bounds)
     before = _receivers(prior.cells, prior.axis, prior.normals, prior.areas)
     after = _receivers(gv.cells, gv.axis, gv.surface_normal, gv.surface_area)
-    old_r = _match(before, after)
+    old_r = _match_receivers(before, after)
     old_c = _match(prior.clusters.records, new.records)
-    gone = _match(after, before) < 0
+    gone = _match_receivers(after, before) < 0
     box = changed_box(np.concatenate([before[gone, :3], after[old_r < 0, :3]]), gv.fine, grid)
     if box is None:
         box = np.zeros((2, 3))
     matrix = build_transfer(ctx, programs, gv, grid, new, occlusion, (old_r < 0, old_c < 0, box))
-    keep = np.isnan(matrix)
-    share = 1.0 - keep.mean()
+    kept = 0
     for side in range(2):  # the kept pairs' old values: prior's columns are sorted by cluster, undo that
+        keep = np.isnan(matrix[side])
+        kept += int(np.count_nonzero(keep))
         position = np.empty(len(prior.order[side]), np.int64)
         position[prior.order[side]] = np.arange(len(position))
-        old = prior.matrix[side][np.maximum(old_c, 0)][:, position[np.maximum(old_r, 0)]]
-        np.copyto(matrix[side], old, where=keep[side])
-    return new, matrix, share
+        old = prior.matrix[side][np.ix_(np.maximum(old_c, 0), position[np.maximum(old_r, 0)])]  # one gather
+        np.copyto(matrix[side], old, where=keep)
+    return new, matrix, 1.0 - kept / max(matrix.size, 1)
 
 
 @dataclass

@@ -266,3 +266,18 @@ def test_the_first_bounce_is_linear_in_the_lights():
     both, alone = injected([sun], (1.0, 1.0, 1.0)), injected([sun], (0.0, 0.0, 0.0)) + injected([], (1.0,) * 3)
     print(f"first bounce, sun and sky: {both:.4f} W; each alone, summed: {alone:.4f} W")
     assert both == pytest.approx(alone, rel=1e-3)
+
+
+@pytest.mark.parametrize("transport", ["transfer", "gather"])
+def test_skipping_empty_space_changes_no_visibility(monkeypatch, transport):
+    """The visibility walk skips the cells an empty cell's distance vouches for (crossings.mark_empty_space); a walk
+    through every cell (the distances left out) gives the same image bit for bit, the cells' exits being computed
+    alike both ways (lpv/gather.glsl cell_exit). A skip one cell too long lets light through the box or a wall."""
+    from bounce_gi.gpu_kernels.lpv import crossings
+
+    settings = replace(SETTINGS, lpv=replace(SETTINGS.lpv, transport=transport))
+    skipped = Engine().render(_room(), settings)
+    monkeypatch.setattr(crossings, "mark_empty_space", lambda coverage: None)
+    walked = Engine().render(_room(), settings)
+    assert _indirect(walked).max() > 0
+    assert np.array_equal(_indirect(skipped), _indirect(walked))

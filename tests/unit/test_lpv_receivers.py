@@ -82,3 +82,27 @@ def test_a_pillars_two_faces_in_one_cell_are_two_layers_a_curve_is_one():
             assert sorted(abs(v) for v in (near, far)) == pytest.approx([0.05, 0.95])
     plain = cx.crossing_layers(*_cells_of(grid, two)[:2], grid)
     assert plain["layers"][0, 0, 0, 1] > 0
+
+
+def test_the_empty_space_distance_is_the_chebyshev_distance_to_the_nearest_surface_cell():
+    """crossings.empty_distance against brute force on a random mask (and capped, and with no surface at all):
+    lpv/gather.glsl skips distance − 1 cells on its strength, so one cell too many would let a ray pass a wall."""
+    rng = np.random.default_rng(7)
+    mask = rng.random((9, 7, 11)) < 0.02
+    d = cx.empty_distance(mask, cap=16)
+    cells = np.argwhere(mask)
+    every = np.stack(np.meshgrid(*[np.arange(n) for n in mask.shape], indexing="ij"), -1).reshape(-1, 1, 3)
+    brute = np.abs(every - cells[None]).max(axis=-1).min(axis=1).reshape(mask.shape)
+    assert (d == np.minimum(brute, 16)).all()
+    assert (cx.empty_distance(mask, cap=3) == np.minimum(brute, 3)).all()
+    assert (cx.empty_distance(np.zeros((4, 4, 4), bool), cap=5) == 5).all()
+
+
+def test_empty_cells_carry_their_distance_and_surface_cells_keep_their_planes():
+    """mark_empty_space writes the distance into w of the cells lpv/gather.glsl reads as empty only: a plane cell's
+    negative w (its coverage) and an axis cell's box code stay."""
+    coverage = np.zeros((1, 1, 5, 4), np.float32)
+    coverage[0, 0, 0] = (0.0, 0.0, 1.0, -0.8)  # a plane cell
+    coverage[0, 0, 4] = (0.5, 0.0, 0.0, 1234.0)  # an axis cell and its box code
+    cx.mark_empty_space(coverage)
+    assert coverage[0, 0, :, 3].tolist() == pytest.approx([-0.8, 1.0, 2.0, 1.0, 1234.0])

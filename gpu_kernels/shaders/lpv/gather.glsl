@@ -129,6 +129,12 @@ vec3 own_ends(vec3 own, vec3 end) {
     return mix(vec3(LAYER_END), end, vec3(greaterThanEqual(abs(own), vec3(OWN_FACING))));
 }
 
+// The ray parameters (cells) at which o + t·dir leaves cell c across each axis; never along an axis dir does not move
+// on (1e30 × a fraction of a cell would be a huge negative parameter, and that axis stepped first for nothing).
+vec3 cell_exit(ivec3 c, vec3 o, vec3 dir, vec3 inv) {
+    return mix((vec3(c) + step01(dir) - o) * inv, vec3(1e30), equal(dir, vec3(0.0)));
+}
+
 // Visibility between a VPL at `from` (normal n_from) and a receiver (normal n_to) `dist` away along unit `dir`: the ray walks the LPV cells it passes
 // (the traversal of Amanatides and Woo 1987) and, in each, meets the cell's surfaces only if it crosses the plane where
 // they lie inside the cell, inside the box they span — one oblique plane, or one per axis where a floor meets a wall,
@@ -144,8 +150,7 @@ float transmittance(vec3 from, vec3 n_from, vec3 dir, float dist, vec3 n_to) {
     ivec3 step = ivec3(sign(dir));
     vec3 inv = vec3(dir.x != 0.0 ? 1.0 / dir.x : 1e30, dir.y != 0.0 ? 1.0 / dir.y : 1e30,
                     dir.z != 0.0 ? 1.0 / dir.z : 1e30);
-    vec3 t_max = (vec3(c) + step01(dir) - o) * inv;
-    vec3 t_delta = abs(inv);
+    vec3 t_max = cell_exit(c, o, dir, inv);
     float t = 0.0, crossings = 0.0;
     int cells = u_grid_size.x + u_grid_size.y + u_grid_size.z + 3;  // a straight line visits no more
     for (int k = 0; k < cells && t < len; ++k) {
@@ -169,11 +174,21 @@ float transmittance(vec3 from, vec3 n_from, vec3 dir, float dist, vec3 n_to) {
                                                          vec4(coverage.xyz * two, coverage.w)) : 0.0);
             }
             if (crossings >= 1.0) return 0.0;
+            if (coverage.w >= 2.0 && coverage.xyz == vec3(0.0)) {  // empty, and so is every cell within w − 1
+                // (lpv/crossings.mark_empty_space): the ray moves at most w − 1 cells along any axis over that
+                // length, so it meets no surface there; go on from the cell it reaches (proximity clouds:
+                // Cohen and Sheffer 1994)
+                t += coverage.w - 1.0;
+                if (t >= len) break;
+                c = ivec3(floor(o + dir * t));
+                t_max = cell_exit(c, o, dir, inv);
+                continue;
+            }
         }
         int axis = t_max.x <= t_max.y ? (t_max.x <= t_max.z ? 0 : 2) : (t_max.y <= t_max.z ? 1 : 2);
         c[axis] += step[axis];
-        t_max[axis] += t_delta[axis];
-        t = t_exit;
+        t_max = cell_exit(c, o, dir, inv);  // not accumulated: a layer on a cell's face (a wall on the grid) is
+        t = t_exit;                         // met at exactly the parameter its crossing test computes
     }
     return 1.0 - crossings;
 }
