@@ -118,13 +118,15 @@ def _match_receivers(old: np.ndarray, new: np.ndarray) -> np.ndarray:
     return np.where(same, index, -1)
 
 
-def changed_box(moved: np.ndarray, fine: Grid, grid: Grid):
-    """The box (2, 3) around the fine voxels `moved` (cells that appeared, vanished, or got another normal or
-    area), grown by an LPV cell (a cell's visibility planes come from the voxels in it); None when none did."""
+def changed_box(moved: np.ndarray, grid: Grid):
+    """The box (2, 3) of the LPV cells holding the fine voxels `moved` (voxels that appeared, vanished, or got
+    another normal or area): a cell's visibility planes come from its eight voxels (lpv/crossings.py; LPV cell c
+    holds fine voxels 2c + 1 and 2c + 2 along each axis). None when none did."""
     if len(moved) == 0:
         return None
-    centre = np.asarray(fine.origin) + (moved + 0.5) * fine.cell
-    return np.stack([centre.min(axis=0) - grid.cell, centre.max(axis=0) + grid.cell])
+    cells = np.floor((np.asarray(moved) - 1) / 2)
+    origin = np.asarray(grid.origin)
+    return np.stack([origin + cells.min(axis=0) * grid.cell, origin + (cells.max(axis=0) + 1) * grid.cell])
 
 
 def update_transfer(ctx, programs, gv, grid: Grid, occlusion: bool, prior) -> tuple:
@@ -140,7 +142,7 @@ def update_transfer(ctx, programs, gv, grid: Grid, occlusion: bool, prior) -> tu
     old_r = _match_receivers(before, after)
     old_c = _match(prior.clusters.records, new.records)
     gone = _match_receivers(after, before) < 0
-    box = changed_box(np.concatenate([before[gone, :3], after[old_r < 0, :3]]), gv.fine, grid)
+    box = changed_box(np.concatenate([before[gone, :3], after[old_r < 0, :3]]), grid)
     if box is None:
         box = np.zeros((2, 3))
     matrix = build_transfer(ctx, programs, gv, grid, new, occlusion, (old_r < 0, old_c < 0, box))
