@@ -5,7 +5,7 @@ gives their irradiance (lpv/absorb.glsl) and, times albedo, the next bounce's VP
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -47,6 +47,11 @@ class GeometryVolume:
     # where the grid is too large for light_volumes
 
     layers_far: object = None  # per LPV cell (lpv/crossings.py): the far layers where its surfaces form two
+    # Material edits without a voxelisation (lpv/receivers.current_albedo): the materials surface_albedo was made
+    # with (receivers.albedo_signature) and, per material index, the (2, R) share of each receiver side it covers
+    materials_key: str | None = None
+    material_signature: list | None = None
+    material_weights: dict = field(default_factory=dict)
 
     def release(self):
         for t in (self.blocking, self.area, self.normal, self.albedo, self.coverage, self.layers, self.surfaces,

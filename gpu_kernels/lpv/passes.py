@@ -155,14 +155,14 @@ def _transfer_geometry(frame, grids, k_grids, budget) -> tuple:
 
     def volumes():
         gvs = receivers.axis_volumes(ctx, programs, scene, frame.geometry, frame.textures, grids)
-        for gv in gvs:
-            gv.materials_key = materials  # whose albedo gv.surface_albedo holds
+        signature = receivers.albedo_signature(scene, frame.textures)
+        for gv in gvs:  # the materials gv.surface_albedo was made with
+            gv.materials_key, gv.material_signature = materials, signature
         return gvs
     gvs = cache.run("geometry_volume", k_gv, volumes)
     k_albedo = (k_gv, materials)
-    albedo = cache.run("lpv_albedo", k_albedo, lambda: [
-        gv.surface_albedo if gv.materials_key == materials else
-        receivers.axis_albedo(ctx, programs, scene, frame.geometry, frame.textures, gv) for gv in gvs])
+    albedo = cache.run("lpv_albedo", k_albedo, lambda: [receivers.current_albedo(
+        ctx, programs, scene, frame.geometry, frame.textures, gv, materials) for gv in gvs])
     k_tr = (k_gv, budget, s.occlusion)
     priors = next((value for key, value in cache.kept("lpv_transfer") if key[1:] == k_tr[1:]
                    and [t.grid for t in value] == list(grids)), [None] * len(gvs))

@@ -27,14 +27,14 @@ import numpy as np
 
 from ..common.grid import Grid
 from ..gl.bind import ssbo
-from ..scene import Scene
+from ..scene import Scene, hash_parts
 from .crossings import Surfaces, crossing_layers, volume_fields
 from .occlusion import KEEP_FRONT_BYTES, GeometryVolume, face_blocking, fine_grid, layer_area, side_albedo
 
 AXES = 3
 
 
-def _per_axis(ctx, programs, scene: Scene, geometry, textures, fine: Grid, names, front=None):
+def _per_axis(ctx, programs, scene: Scene, geometry, textures, fine: Grid, names, front=None, albedo_override=None):
     """[arrays of axis 0, 1, 2] (VoxelVolumes.read(names)) and the front-most image every pass shared (made by the
     first pass unless `front` is given; None where the grid keeps one albedo per voxel)."""
     from ..voxel.voxelize import voxelize
@@ -42,7 +42,8 @@ def _per_axis(ctx, programs, scene: Scene, geometry, textures, fine: Grid, names
     out = []
     for axis in range(AXES):
         vox = voxelize(ctx, programs, scene, geometry, textures, fine, sides=True, front=front,
-                       keep_front=front is None, axis_only=axis, positions="position" in names)
+                       keep_front=front is None, axis_only=axis, positions="position" in names,
+                       albedo_override=albedo_override)
         front = front if front is not None else vox.front
         out.append(vox.read(names))
         vox.release()
@@ -154,10 +155,13 @@ def _receivers(arrays: list, fine: Grid) -> dict:
     return out
 
 
-def axis_albedo(ctx, programs, scene: Scene, geometry, textures, gv: GeometryVolume) -> np.ndarray:
+def axis_albedo(ctx, programs, scene: Scene, geometry, textures, gv: GeometryVolume,
+                albedo_override=None) -> np.ndarray:
     """(2, R, 3): the two sides' albedo of `gv`'s receivers under the scene's current materials (a material edit
-    changes no geometry: three voxelisations whose occupancy is discarded, the front-most image reused)."""
-    arrays, front = _per_axis(ctx, programs, scene, geometry, textures, gv.fine, ("albedo", "albedo_back"), gv.front)
+    changes no geometry: three voxelisations whose occupancy is discarded, the front-most image reused), or under
+    `albedo_override` (voxel/voxelize.py)."""
+    arrays, front = _per_axis(ctx, programs, scene, geometry, textures, gv.fine, ("albedo", "albedo_back"), gv.front,
+                              albedo_override)
     if gv.front is None and front is not None:
         front.release()
     out = np.zeros((2, gv.surface_count, 3), np.float32)
@@ -165,6 +169,68 @@ def axis_albedo(ctx, programs, scene: Scene, geometry, textures, gv: GeometryVol
         mine = gv.axis == axis
         out[:, mine] = side_albedo(a, gv.cells[mine])
     return out
+
+
+# A material edit without a voxelisation. A receiver side's albedo is the area-weighted mean of the albedo of the
+# surfaces it sees (voxel/resolve.glsl), so for materials of one constant albedo each (no base-colour texture) it is
+# Σ_m w_m · albedo_m, w_m the share of the side's seen area that material m covers — geometry only. An edit then
+# costs, per edited material, its weights once (one voxelisation per axis with a one-hot colour, three materials a
+# pass) and a multiply-add each time after: dragging a colour re-voxelises nothing after its first step.
+
+def albedo_signature(scene: Scene, textures) -> list:
+    """Per material index, what sets its voxel albedo (voxel/common.glsl voxel_albedo): ("rgb", albedo) for a
+    constant one, ("texture", its content key, scale, offset) for a textured one."""
+    out = []
+    for m, mat in enumerate(scene.materials):
+        scale, offset = (np.asarray(v, np.float64) for v in textures.transport[m])
+        if 0 <= mat.base_color_texture < len(scene.textures):
+            out.append(("texture", hash_parts(scene.textures[mat.base_color_texture]), tuple(scale), tuple(offset)))
+        else:
+            base = np.maximum(np.asarray(mat.base_color[:3], np.float64), 0.0)
+            out.append(("rgb", tuple(base * scale + offset)))
+    return out
+
+
+def edited_materials(before: list | None, now: list) -> list | None:
+    """The material indices whose constant albedo changed from `before` to `now`, or None where the linear update
+    cannot follow the edit (no record, materials added or removed, a textured material edited)."""
+    if before is None or len(before) != len(now):
+        return None
+    changed = [m for m, (b, n) in enumerate(zip(before, now)) if b != n]
+    return None if any(before[m][0] != "rgb" or now[m][0] != "rgb" for m in changed) else changed
+
+
+def material_weights(ctx, programs, scene: Scene, geometry, textures, gv: GeometryVolume, materials) -> dict:
+    """{m: (2, R) float32}: the share of each receiver side's seen area that material m covers, for each m in
+    `materials`, three a voxelisation (one-hot in r, g, b)."""
+    out, materials = {}, list(materials)
+    for i in range(0, len(materials), 3):
+        group = materials[i:i + 3]
+        one_hot = {m: tuple(float(j == k) for j in range(3)) for k, m in enumerate(group)}
+        shares = axis_albedo(ctx, programs, scene, geometry, textures, gv, one_hot)
+        out.update({m: np.ascontiguousarray(shares[..., k]) for k, m in enumerate(group)})
+    return out
+
+
+def current_albedo(ctx, programs, scene: Scene, geometry, textures, gv: GeometryVolume, materials_key: str):
+    """(2, R, 3): `gv`'s receivers' albedo under the scene's current materials (`materials_key`): gv's own where it
+    was made with them; after an edit of constant-albedo materials, gv's plus each edited material's weights × its
+    change of albedo; else a re-voxelisation, which becomes gv's albedo for the next edit."""
+    if gv.materials_key == materials_key:
+        return gv.surface_albedo
+    now = albedo_signature(scene, textures)
+    changed = edited_materials(gv.material_signature, now)
+    if changed is None:
+        gv.surface_albedo = axis_albedo(ctx, programs, scene, geometry, textures, gv)
+        gv.material_signature, gv.materials_key = now, materials_key
+        return gv.surface_albedo
+    missing = [m for m in changed if m not in gv.material_weights]
+    gv.material_weights.update(material_weights(ctx, programs, scene, geometry, textures, gv, missing))
+    out = gv.surface_albedo.astype(np.float64)
+    for m in changed:
+        delta = np.subtract(now[m][1], gv.material_signature[m][1])
+        out += gv.material_weights[m][..., None] * delta
+    return np.maximum(out, 0.0).astype(np.float32)  # rounding must not make a reflectance negative
 
 
 LIGHT_VOLUME_BYTES = 256 * 2 ** 20  # the six dense volumes' budget (a 64-cell grid's fit), else the sparse index

@@ -91,7 +91,8 @@ class VoxelVolumes:
 
 def voxelize(ctx, programs, scene: Scene, geometry, textures, grid: Grid, mode: str = "raster",
              supersample: int = 2, scale_bits: int = DEFAULT_SCALE_BITS, sides: bool = False, front=None,
-             keep_front: bool = False, axis_only: int = -1, positions: bool = False) -> VoxelVolumes:
+             keep_front: bool = False, axis_only: int = -1, positions: bool = False,
+             albedo_override: dict | None = None) -> VoxelVolumes:
     """Voxelise the scene's surfaces into `grid` (GL thread); returns new textures the caller releases.
 
     `geometry`: direct/geometry.GeometryBuffers of `scene` (raster draws its VBO; tessellation uploads its own patch
@@ -106,16 +107,21 @@ def voxelize(ctx, programs, scene: Scene, geometry, textures, grid: Grid, mode: 
     LPV's receivers, one per voxel and axis (lpv/occlusion.py) — and −1 all of them. The front-most image is per
     dominant axis, so one made of every triangle serves each axis. `positions` (raster only) adds the surfaces'
     area-weighted centroid and box per voxel (VoxelVolumes.position, extent_lo, extent_hi).
+    `albedo_override` (raster only), {material index: rgb}: those materials' surfaces get that constant albedo and
+    every other surface none — the areas stay, so a one-hot colour gives each voxel side the share of its seen area
+    a material covers (lpv/receivers.material_weights).
     """
     import moderngl
 
     _check_grid(ctx, grid, mode, supersample)
-    if (axis_only >= 0 or positions) and mode != "raster":
-        raise ValueError("axis_only and positions need mode='raster'")
+    if (axis_only >= 0 or positions or albedo_override is not None) and mode != "raster":
+        raise ValueError("axis_only, positions and albedo_override need mode='raster'")
     supersample = int(supersample)
     nx, ny, nz = grid.size
     used = sorted({m for m, _, _ in geometry.ranges})
     albedo_max, emission_max = material_maxima(scene, used, textures.transport)
+    if albedo_override is not None:
+        albedo_max = max([float(max(c)) for c in albedo_override.values()] + [0.0]) or 1.0
     sides = bool(sides) and mode == "raster" and _sides_fit(ctx, grid, supersample)
     positions = bool(positions)
     accs = [ctx.texture3d((4 * nx, ny, nz), 1, dtype="u4") for _ in range(4 + sides)]
@@ -136,7 +142,8 @@ def voxelize(ctx, programs, scene: Scene, geometry, textures, grid: Grid, mode: 
     try:
         reruns = 0
         while _deposit(ctx, programs, scene, (geometry, patches), textures, grid, supersample,
-                       {**uniforms, "u_fixed_scale": float(2.0 ** scale_bits)}, images, defines) and scale_bits > 0:
+                       {**uniforms, "u_fixed_scale": float(2.0 ** scale_bits)}, images, defines,
+                       albedo_override) and scale_bits > 0:
             scale_bits = _smaller_scale(scene, grid, scale_bits, reruns)
             reruns += 1
         volumes = _resolve(ctx, programs, accs, grid, scale_bits, albedo_max, emission_max, sides, positions)
@@ -151,7 +158,8 @@ def voxelize(ctx, programs, scene: Scene, geometry, textures, grid: Grid, mode: 
                         **dict(zip(("position", "extent_lo", "extent_hi"), volumes[-3:] if positions else ())))
 
 
-def _deposit(ctx, programs, scene, buffers, textures, grid, supersample, uniforms, images, defines) -> bool:
+def _deposit(ctx, programs, scene, buffers, textures, grid, supersample, uniforms, images, defines,
+             albedo_override=None) -> bool:
     """One voxelisation pass into the accumulators, zeroed first (`images`: (unit, texture) of voxel/common.glsl,
     the flags at unit 4 and the front-most image, read only, at 6), drawn from `buffers` = (geometry, tessellation
     patches or None); True where a voxel's area sum wrapped."""
@@ -165,7 +173,8 @@ def _deposit(ctx, programs, scene, buffers, textures, grid, supersample, uniform
     for unit, t in images:
         t.bind_to_image(unit, read=True, write=True)
     if patches is None:
-        _draw_raster(ctx, programs, scene, geometry, textures, grid, supersample, uniforms, defines or None)
+        _draw_raster(ctx, programs, scene, geometry, textures, grid, supersample, uniforms, defines or None,
+                     albedo_override)
     else:
         draw_tessellated(ctx, programs, scene, patches, textures, uniforms)
     ctx.memory_barrier()
@@ -248,7 +257,8 @@ def material_maxima(scene: Scene, used, transport: np.ndarray) -> tuple[float, f
     return (albedo if albedo > 0 else 1.0), (emission if emission > 0 else 0.0)
 
 
-def _draw_raster(ctx, programs, scene, geometry, textures, grid, supersample, uniforms, defines=None) -> None:
+def _draw_raster(ctx, programs, scene, geometry, textures, grid, supersample, uniforms, defines=None,
+                 albedo_override=None) -> None:
     import moderngl
 
     prog = programs.raster("voxel/raster.glsl", defines)
@@ -265,10 +275,20 @@ def _draw_raster(ctx, programs, scene, geometry, textures, grid, supersample, un
         ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
         for mat_index, first, count in geometry.ranges:
             bind_material(prog, scene, mat_index, textures)
+            if albedo_override is not None:
+                _override_albedo(prog, albedo_override.get(mat_index, (0.0, 0.0, 0.0)))
             vao.render(moderngl.TRIANGLES, vertices=count, first=first)
     finally:
         vao.release()
         fbo.release()
+
+
+def _override_albedo(prog, rgb) -> None:
+    """voxel/common.glsl voxel_albedo returns `rgb` for the material just bound."""
+    set_uniform(prog, "u_base_color", tuple(float(c) for c in rgb))
+    set_uniform(prog, "u_albedo_scale", (1.0, 1.0, 1.0))
+    set_uniform(prog, "u_albedo_offset", (0.0, 0.0, 0.0))
+    set_uniform(prog, "u_use_texture", False)
 
 
 def _resolve(ctx, programs, accs, grid, scale_bits, albedo_max, emission_max, sides, positions) -> list:

@@ -59,9 +59,11 @@ def test_a_rug_on_a_floor_bounces_its_own_colour(engine, bounces):
 
 
 def test_a_material_edit_reuses_the_front_most_image_and_gives_a_cold_render(engine):
-    """A material edit re-voxelises only the albedo, reading the front-most image kept with the geometry volume
-    (lpv/occlusion.KEEP_FRONT_BYTES) instead of rasterising it again: the recoloured rug's bounce must be exactly
-    what a fresh engine renders (the pipeline is deterministic: fixed-point sums), and blue now."""
+    """A material edit voxelises only the edited material's share of each receiver side (lpv/receivers.py
+    current_albedo), reading the front-most image kept with the geometry volume (lpv/occlusion.KEEP_FRONT_BYTES)
+    instead of rasterising it again: the recoloured rug's bounce must be what a fresh engine renders, to the
+    update's rounding (tests/gpu/test_lpv_material_edit.py: 1e-5 of the albedo; measured here 8.6e-7 of the mean
+    after three bounces, bound 1e-5), and blue now."""
     settings = RenderSettings("lpv", 80, 60, lpv=LpvSettings(resolution=32, bounces=3))
     engine.render(_spot_over_a_rug(), settings)
     blue = _spot_over_a_rug()
@@ -73,6 +75,8 @@ def test_a_material_edit_reuses_the_front_most_image_and_gives_a_cold_render(eng
         cold = cold_engine.render(blue, settings)
     finally:
         cold_engine.shutdown()
-    np.testing.assert_array_equal(warm.passes["Diffuse Indirect"], cold.passes["Diffuse Indirect"])
+    a, b = warm.passes["Diffuse Indirect"], cold.passes["Diffuse Indirect"]
+    print(f"warm vs cold: max |Δ| {np.abs(a - b).max() / b.mean():.1e} of the mean")
+    assert np.abs(a - b).max() <= 1e-5 * float(b.mean())
     di = warm.passes["Diffuse Indirect"][warm.passes["Depth"][..., 0] < 1e9]
     assert di[:, 2].sum() > 2.0 * di[:, 0].sum()  # the blue rug's light
