@@ -111,24 +111,14 @@ def voxelize(ctx, programs, scene: Scene, geometry, textures, grid: Grid, mode: 
     every other surface none — the areas stay, so a one-hot colour gives each voxel side the share of its seen area
     a material covers (lpv/receivers.material_weights).
     """
-    import moderngl
-
     _check_grid(ctx, grid, mode, supersample)
     if (axis_only >= 0 or positions or albedo_override is not None) and mode != "raster":
         raise ValueError("axis_only, positions and albedo_override need mode='raster'")
     supersample = int(supersample)
-    nx, ny, nz = grid.size
-    used = sorted({m for m, _, _ in geometry.ranges})
-    albedo_max, emission_max = material_maxima(scene, used, textures.transport)
-    if albedo_override is not None:
-        albedo_max = max([float(max(c)) for c in albedo_override.values()] + [0.0]) or 1.0
+    albedo_max, emission_max = _maxima(scene, geometry, textures, albedo_override)
     sides = bool(sides) and mode == "raster" and _sides_fit(ctx, grid, supersample)
     positions = bool(positions)
-    accs = [ctx.texture3d((4 * nx, ny, nz), 1, dtype="u4") for _ in range(4 + sides)]
-    accs += [ctx.texture3d((4 * nx, 3 * ny, nz), 1, dtype="u4")] * positions  # voxel/common.glsl acc_position
-    flags = ctx.texture3d((1, 1, 1), 1, np.zeros(1, np.uint32).tobytes(), dtype="u4")
-    for t in accs + [flags]:
-        t.filter = (moderngl.NEAREST, moderngl.NEAREST)
+    accs, flags = _accumulators(ctx, grid, sides, positions)
     patches = patch_buffers(ctx, scene, grid, supersample) if mode == "tessellation" else None
     own_front = sides and front is None
     fronts = ([front] if front is not None else _front_most(ctx, programs, scene, geometry, textures, grid,
@@ -156,6 +146,28 @@ def voxelize(ctx, programs, scene: Scene, geometry, textures, grid: Grid, mode: 
                         reruns=reruns, albedo_back=volumes[4] if sides else None,
                         front=fronts[0] if own_front and keep_front else None,
                         **dict(zip(("position", "extent_lo", "extent_hi"), volumes[-3:] if positions else ())))
+
+
+def _maxima(scene, geometry, textures, albedo_override) -> tuple[float, float]:
+    """The fixed-point ranges of the albedo and emission sums: the materials' maxima, the override's albedo."""
+    used = sorted({m for m, _, _ in geometry.ranges})
+    albedo_max, emission_max = material_maxima(scene, used, textures.transport)
+    if albedo_override is not None:
+        albedo_max = max([float(max(c)) for c in albedo_override.values()] + [0.0]) or 1.0
+    return albedo_max, emission_max
+
+
+def _accumulators(ctx, grid: Grid, sides: bool, positions: bool) -> tuple[list, object]:
+    """The integer accumulators voxel/common.glsl adds into (4, + albedo_back, + acc_position) and the flags."""
+    import moderngl
+
+    nx, ny, nz = grid.size
+    accs = [ctx.texture3d((4 * nx, ny, nz), 1, dtype="u4") for _ in range(4 + sides)]
+    accs += [ctx.texture3d((4 * nx, 3 * ny, nz), 1, dtype="u4")] * positions
+    flags = ctx.texture3d((1, 1, 1), 1, np.zeros(1, np.uint32).tobytes(), dtype="u4")
+    for t in accs + [flags]:
+        t.filter = (moderngl.NEAREST, moderngl.NEAREST)
+    return accs, flags
 
 
 def _deposit(ctx, programs, scene, buffers, textures, grid, supersample, uniforms, images, defines,
