@@ -321,7 +321,7 @@ def _add_lamp(out: _Records, scene: Scene, light: Light, s: ShadowSettings) -> N
         pts = area_sample_points(light, s.area_samples) if light.cast_shadow else []
         for point in pts:
             v.extend(cube_views(point, s.sample_cube_resolution, *_near_far(scene, point),
-                                np.asarray(light.direction, np.float64), 1.0 / len(pts)))
+                                np.asarray(light.direction, np.float64), area / len(pts)))
         out.add(LIGHT_POLYGON, radiance, poly.mean(axis=0), 0.0, light.direction, light_views=v,
                 samples=len(pts), per=6, poly=poly)
     else:

@@ -24,10 +24,22 @@ class ShadowAtlas:
     buffers: lb.LightBuffers  # the CPU-side records (RSMs reuse the views)
     owns_depth: bool = True  # False where the depth atlas is cached apart (render_shadow_atlas's depth_pass)
     views_key: str = ""  # views_key: what the maps and records are besides the lights' colours
+    _raw: object = None
+
+    def raw_depth(self):
+        """A sampler reading `depth`'s values without comparison, nearest (made on first use)."""
+        import moderngl
+
+        if self._raw is None:
+            self._raw = self.depth.ctx.sampler(repeat_x=False, repeat_y=False, filter=(moderngl.NEAREST,
+                                               moderngl.NEAREST), compare_func="", texture=self.depth)
+        return self._raw
 
     def release(self):
         for obj in (self.light_ssbo, self.view_ssbo, self.polygon_ssbo) + ((self.depth,) if self.owns_depth else ()):
             obj.release()
+        if self._raw is not None:
+            self._raw.release()
 
 
 def render_shadow_atlas(ctx, programs, scene: Scene, geometry: GeometryBuffers,

@@ -94,6 +94,12 @@ def bind_grid(prog, grid, levels: int | None = None) -> None:
         set_uniform(prog, "u_max_lod", float(levels - 1))
 
 
+# The shadow atlas read without comparison (direct/eval.glsl u_shadow_depth: the soft shadows' blocker search) is a
+# sampler object on the atlas, bound on a unit nothing else uses: a sampler stays bound to its unit and would
+# override the filtering of any other texture put there.
+RAW_DEPTH_UNIT = 31
+
+
 def bind_lights(prog, shadows, unit: int, exclude_trapped: bool = False, sky_stride: int = 1) -> int:
     """The lights, shadow views, polygons and shadow atlas of direct/eval.glsl (storage buffers 0–2, the atlas on
     texture unit `unit`); returns the next free unit. exclude_trapped: the light trapped inside closed emitters is
@@ -102,6 +108,9 @@ def bind_lights(prog, shadows, unit: int, exclude_trapped: bool = False, sky_str
 
     shadows.depth.use(location=unit)
     set_uniform(prog, "u_shadow_atlas", unit)
+    if "u_shadow_depth" in prog:
+        shadows.raw_depth().use(location=RAW_DEPTH_UNIT)
+        set_uniform(prog, "u_shadow_depth", RAW_DEPTH_UNIT)
     set_uniform(prog, "u_exclude_trapped", bool(exclude_trapped))
     set_uniform(prog, "u_sky_stride", int(sky_stride))
     set_uniform(prog, "u_atlas_texel", (1.0 / shadows.size[0], 1.0 / shadows.size[1]))

@@ -323,10 +323,11 @@ def test_build_light_buffers_units_and_views():
     for v in buf.views[1:7]:
         np.testing.assert_allclose(v.origin, point.matrix_world[:3, 3])
     area_pts = np.array([v.origin for v in buf.views[8:]])
-    # Each area sample point emits along the light's direction and stands for a quarter of it (polygon_visibility).
+    # Each area sample point emits along the light's direction and stands for a quarter of its area (m²: the
+    # weights of polygon_visibility and the patch its soft shadow is filtered for).
     for v in buf.views[8:]:
         np.testing.assert_allclose(v.emit_normal, area.direction, atol=1e-12)
-        assert v.emit_share == pytest.approx(0.25)
+        assert v.emit_share == pytest.approx(lb.area_polygon(area)[1] / 4)
     assert all(v.emit_normal is None for v in buf.views[:8])
     plane_n = area.matrix_world[:3, 2] / np.linalg.norm(area.matrix_world[:3, 2])
     assert np.abs((area_pts - area.matrix_world[:3, 3]) @ plane_n).max() < 1e-9

@@ -10,6 +10,7 @@
 #define OFFSET_TEXELS 1.5  // normal offset of a shadow test, in shadow texels
 #define MAX_SLOPE 8.0      // cap of its slope-scaled part (tan θ) for a light's own maps
 uniform sampler2DShadow u_shadow_atlas;
+uniform sampler2D u_shadow_depth;  // the same atlas's depths, read without comparison (gl/bind.RAW_DEPTH_UNIT)
 uniform vec2 u_atlas_texel;        // 1 / atlas size
 // true for VCT's injection: the samples facing the sealed inside of a closed emitter (ShadowView.emitter.w < 0)
 // count as shadowed, since that light is trapped inside and the voxels would let it out (common/emitters.py).
@@ -82,6 +83,104 @@ float cube_visibility(int first_view, vec3 p, vec3 geo_n) {
     return view_visibility(first_view + cube_face(q - origin), p, geo_n, to_light);
 }
 
+#define PATCH_GATHERS 8            // at most, per axis: 2×2 texels each, over the region a blocker can shadow
+#define MAX_SEARCH_TEXELS 64.0     // that region's half-width cap (texels)
+
+// Atlas uv and stored depth (distance / far) of world point x in perspective view v.
+vec3 view_uv_depth(ShadowView v, vec3 x) {
+    vec4 clip = v.view_projection * vec4(x, 1.0);
+    vec2 uv = clip.xy / clip.w * 0.5 + 0.5;
+    return vec3(v.tile.xy + uv * v.tile.zw, length(x - v.origin.xyz) / v.info.z);
+}
+
+// The share of [−h, h] that [c − w, c + w] covers, per axis.
+vec2 patch_overlap(vec2 c, vec2 w, float h) {
+    return max(min(vec2(h), c + w) - max(vec2(-h), c - w), vec2(0.0)) / (2.0 * h);
+}
+
+// Visibility from p of the patch of a polygon light that sample view `view_index` (a cube face at the sample point)
+// stands for, half-size h (m) as p sees it, by backprojecting the shadow map's blockers onto the patch
+// (Guennebaud et al. 2006, "Real-time soft shadow mapping by backprojection"). A texel at angle φ from p's
+// direction (seen from the sample point) whose surface lies at distance z < d_r hides from p the patch's points at
+// φ / (1/z − 1/d_r) from its centre — its own penumbra, so a blocker touching the receiver shadows sharply and one
+// near the light softly, in the same pixel. The patch's covered share is summed over the texels around p's (their
+// backprojections clamped to the patch; overlaps between blockers at different depths counted twice, then the
+// sum clamped to 1). With the four sample points of a square light and a point's hard shadow each, a soft shadow
+// was four hard ones, banded: the product shot's Diffuse Direct 3.4% off Cycles. A texel is a blocker only in front
+// of the receiver's plane at that texel (Isidoro 2006, "Shadow mapping: GPU-based tips and techniques": receiver-
+// plane depth bias), so the receiver does not shadow itself across the region. A patch too small for its penumbra to
+// span two texels keeps the light's usual PCF.
+float patch_visibility(int view_index, vec3 p, vec3 geo_n, vec3 to_light, float h) {
+    ShadowView v = shadow_views[view_index];
+    vec3 q = biased_point(v, p, geo_n, to_light, MAX_SLOPE);
+    vec4 clip = v.view_projection * vec4(q, 1.0);
+    if (clip.w <= 0.0) return 1.0;
+    vec2 uv = clip.xy / clip.w * 0.5 + 0.5;
+    if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return 1.0;
+    float d_r = length(q - v.origin.xyz);
+    float tau = v.info.x;                      // a texel's angle (texel world size at unit distance)
+    // Blockers at a fifth of the distance or farther: 1/z − 1/d_r ≤ 4/d_r.
+    float search = min(4.0 * h / (d_r * tau), MAX_SEARCH_TEXELS);
+    if (search < 2.0) return view_visibility_biased(view_index, p, geo_n, to_light, MAX_SLOPE);
+    // The receiver plane's depth per atlas uv, from two points one texel apart on it.
+    vec3 t1 = normalize(abs(geo_n.x) < 0.9 ? cross(geo_n, vec3(1, 0, 0)) : cross(geo_n, vec3(0, 1, 0)));
+    vec3 t2 = cross(geo_n, t1);
+    float step_m = d_r * tau;
+    vec3 c0 = view_uv_depth(v, q), ca = view_uv_depth(v, q + t1 * step_m), cb = view_uv_depth(v, q + t2 * step_m);
+    mat2 jac = mat2(ca.xy - c0.xy, cb.xy - c0.xy);
+    vec2 grad = abs(determinant(jac)) > 1e-20 ? vec2(ca.z - c0.z, cb.z - c0.z) * inverse(jac) : vec2(0.0);
+    vec2 lo = v.tile.xy + 0.5 * u_atlas_texel;
+    vec2 hi = v.tile.xy + v.tile.zw - 0.5 * u_atlas_texel;
+    // The nearest blocker among 20 texels over that region sets how far the patch's shadow can reach: the
+    // backprojection's region, over which its gathers are spread as densely as that allows.
+    float nearest = 2.0;
+    for (int k = 0; k < 5; ++k) {
+        vec2 off = k < 4 ? (vec2(k & 1, k >> 1) * 2.0 - 1.0) * (0.5 * search) : vec2(0.0);
+        vec2 centre = floor(clamp(c0.xy + off * u_atlas_texel, lo, hi) / u_atlas_texel - 0.5) + 1.0;
+        vec4 z = textureGather(u_shadow_depth, centre * u_atlas_texel, 0);
+        float ref = c0.z + dot(grad, (centre - c0.xy / u_atlas_texel) * u_atlas_texel);
+        for (int i = 0; i < 4; ++i)
+            if (z[i] < ref) nearest = min(nearest, z[i]);
+    }
+    if (nearest > 1.0) return view_visibility_biased(view_index, p, geo_n, to_light, MAX_SLOPE);
+    float reach = h * (1.0 / max(nearest * v.info.z, 1e-6 * d_r) - 1.0 / d_r) / tau + 1.0;
+    float region = clamp(reach, 2.0, search);
+    // Gathers spaced `spacing` texels apart: each of their texels stands for the block of spacing/2 texels on its
+    // side of the gather (at its centre: `corner` × spacing/2 from the gather's).
+    int gathers = int(min(ceil(region), float(PATCH_GATHERS)));   // 2 texels apart where that covers the region
+    float spacing = max(2.0, 2.0 * region / float(gathers));
+    float half_block = 0.25 * spacing * tau;   // a block's half-width, as an angle
+    vec2 texel_of_p = c0.xy / u_atlas_texel;   // p in atlas texels
+    const vec2 corner[4] = vec2[4](vec2(-0.5, 0.5), vec2(0.5, 0.5), vec2(0.5, -0.5), vec2(-0.5, -0.5));  // gather order
+    float covered = 0.0;
+    for (int j = 0; j < gathers; ++j)
+        for (int i = 0; i < gathers; ++i) {
+            vec2 at = c0.xy + (vec2(i, j) - 0.5 * float(gathers - 1)) * spacing * u_atlas_texel;
+            // snapped between four texel centres, so the gather's texels are known
+            vec2 centre = floor(clamp(at, lo, hi) / u_atlas_texel - 0.5) + 1.0;
+            vec4 z = textureGather(u_shadow_depth, centre * u_atlas_texel, 0);
+            for (int k = 0; k < 4; ++k) {
+                vec2 duv = (centre + corner[k] - texel_of_p) * u_atlas_texel;   // the texel read
+                if (z[k] >= c0.z + dot(grad, duv)) continue;   // not in front of the receiver's plane
+                float depth = z[k] * v.info.z;
+                float k_inv = 1.0 / max(depth, 1e-6 * d_r) - 1.0 / d_r;
+                if (k_inv <= 0.0) continue;
+                vec2 at_block = centre + corner[k] * (0.5 * spacing) - texel_of_p;
+                vec2 o = patch_overlap(at_block * tau / k_inv, vec2(half_block / k_inv), h);
+                covered += o.x * o.y;
+            }
+        }
+    return 1.0 - min(covered, 1.0);
+}
+
+// cube_visibility for a polygon light's sample point standing for a patch of half-size h (patch_visibility).
+float cube_patch_visibility(int first_view, vec3 p, vec3 geo_n, float h) {
+    vec3 origin = shadow_views[first_view].origin.xyz;
+    vec3 to_light = normalize(origin - p);
+    vec3 q = biased_point(shadow_views[first_view], p, geo_n, to_light, MAX_SLOPE);
+    return patch_visibility(first_view + cube_face(q - origin), p, geo_n, to_light, h);
+}
+
 // Weighted visibility of a polygon light from its shadow sample points: each sample k stands for a share A_k of the
 // light's area around it and emits along n_k (ShadowView.emitter), so it is weighted by its own unshadowed point
 // contribution A_k · max(0, n_k·ω) · max(0, n·−ω) / d². A two-sided emitter has a sample on each side of its
@@ -92,6 +191,10 @@ float polygon_visibility(GpuLight L, vec3 p, vec3 n, vec3 geo_n) {
     if (samples == 0) return 1.0;
     int first = int(L.params.y);
     int per = int(L.params.w);
+    // A one-sided polygon (an area light) is filtered per patch (cube_patch_visibility: the patch's half-size as p
+    // sees it, its area A_k foreshortened). Emissive meshes keep hard shadows per sample: their samples sit a nudge
+    // off a surface that curves around them (a lamp shade), whose own texels a backprojection reads as blockers.
+    bool patches = L.polygon.z < 0.5;
     float wsum = 0.0, vsum = 0.0;
     for (int k = 0; k < samples; ++k) {
         int view0 = first + k * per;
@@ -99,10 +202,12 @@ float polygon_visibility(GpuLight L, vec3 p, vec3 n, vec3 geo_n) {
         vec3 d = p - shadow_views[view0].origin.xyz;
         float d2 = max(dot(d, d), 1e-8);
         vec3 w = d * inversesqrt(d2);
-        float weight = abs(e.w) * max(dot(e.xyz, w), 0.0) * max(dot(n, -w), 0.0) / d2;
+        float facing = max(dot(e.xyz, w), 0.0);
+        float weight = abs(e.w) * facing * max(dot(n, -w), 0.0) / d2;
         if (weight <= 0.0) continue;
         wsum += weight;
-        if (!(u_exclude_trapped && e.w < 0.0)) vsum += weight * cube_visibility(view0, p, geo_n);
+        if (!(u_exclude_trapped && e.w < 0.0)) vsum += weight * (patches ? cube_patch_visibility(
+            view0, p, geo_n, 0.5 * sqrt(abs(e.w) * facing)) : cube_visibility(view0, p, geo_n));
     }
     return wsum > 0.0 ? vsum / wsum : 1.0;
 }
