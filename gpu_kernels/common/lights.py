@@ -58,8 +58,8 @@ class ShadowSettings:
     emissive_sample_budget: int = 64
     pcf_radius: int = 1  # PCF kernel (2r+1)²
     # The world's light: shadow directions over the whole sphere (0: the world lights unshadowed) and texels per
-    # side of each one's map. Many small maps rather than a few large ones: the error of the sky's visibility is
-    # that of a quadrature over directions (an opening seen through few of them bands), not of the texel size.
+    # side of each one's map. Many small maps rather than a few large ones: the sky's visibility is a quadrature
+    # over directions (its bands smoothed by direct/sky_filter.glsl), whose error the texel size hardly moves.
     sky_directions: int = 384
     sky_resolution: int = 192
 

@@ -27,19 +27,39 @@ def render_direct_light(ctx, programs, gbuffer: GBuffer, shadows: ShadowAtlas, m
 
 
 def render_sky_visibility(ctx, programs, gbuffer: GBuffer, shadows: ShadowAtlas, material_lut=None):
-    """RG32F per G-buffer pixel: the sky light's visible shares (direct/light.glsl MODE_SKY: x of its cosine weight,
-    y of the glossy lobe's), or None where the scene has no sky light. They depend on the G-buffer and the sky's
-    shadow maps, not on the world's colour: the pipeline keeps them across world and light edits, and the Diffuse
-    Direct pass reads them instead of testing the sky's hundreds of directions again."""
+    """RGBA32F per G-buffer pixel: the sky light's visible shares (direct/light.glsl MODE_SKY: x of its cosine
+    weight, y of the glossy lobe's, z its penumbra's half-width in metres), averaged over that penumbra on the
+    pixel's own surface (direct/sky_filter.glsl), or None where the scene has no sky light. They depend on the
+    G-buffer and the sky's shadow maps, not on the world's colour: the pipeline keeps them across world and light
+    edits, and the Diffuse Direct pass reads them instead of testing the sky's hundreds of directions again."""
     if not any(int(t) == lb.LIGHT_SKY for t in shadows.buffers.lights["color_type"][:, 3]):
         return None
     w, h = gbuffer.size
-    out = ctx.texture((w, h), 2, dtype="f4")
+    out = ctx.texture((w, h), 4, dtype="f4")
     prog = programs.compute("direct/light.glsl", {"MODE_SKY": None})
     out.bind_to_image(2, read=False, write=True)
     _bind_inputs(prog, gbuffer, shadows, material_lut)
     dispatch(prog, (w, h), local=8)
-    return out
+    return filter_sky_shares(ctx, programs, gbuffer, out)
+
+
+def filter_sky_shares(ctx, programs, gbuffer: GBuffer, shares):
+    """The sky's shares averaged over each pixel's penumbra on its own surface, one image axis at a time
+    (direct/sky_filter.glsl); releases `shares`."""
+    w, h = gbuffer.size
+    prog = programs.compute("direct/sky_filter.glsl")
+    unit = bind_samplers(prog, "u_position", [gbuffer.textures["position"]], 0)
+    unit = bind_samplers(prog, "u_geo_normal", [gbuffer.textures["geo_normal"]], unit)
+    set_uniform(prog, "u_size", (w, h))
+    for axis in ((1, 0), (0, 1)):
+        out = ctx.texture((w, h), 4, dtype="f4")
+        bind_samplers(prog, "u_shares", [shares], unit)
+        out.bind_to_image(0, read=False, write=True)
+        set_uniform(prog, "u_axis", axis)
+        dispatch(prog, (w, h), local=8)
+        shares.release()
+        shares = out
+    return shares
 
 
 def _bind_inputs(prog, gbuffer: GBuffer, shadows: ShadowAtlas, material_lut) -> int:

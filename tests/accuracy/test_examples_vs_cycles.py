@@ -55,6 +55,11 @@ from examples import references  # noqa: E402
 # patch_visibility) moved metals' VCT Diffuse Indirect from 0.1487 to 0.1502 (the voxels are lit like the pixels):
 # within its noise floor (0.032), but past the 0.15 target it had met, so it is held by the rule instead; the
 # product shot's rows tightened to the rule after it (Diffuse Direct 0.034 -> 0.022, Combined 0.048 -> 0.036).
+# 2026-12-04 (second session): the sky's shares averaged over each pixel's penumbra on its own surface
+# (direct/sky_filter.glsl) re-measured the four sky-lit scenes: Diffuse Direct window_room 0.093 -> 0.070,
+# thin_walls 0.180 -> 0.111, furnished 0.0198 -> 0.0191, outdoor 0.0144 (unchanged); Glossy Direct 0.159 -> 0.138
+# and 0.297 -> 0.220 in the two rooms; outdoor's Combined rose 0.0433 -> 0.0444 (LPV) and 0.0482 -> 0.0499 (VCT),
+# so its bounds rose with it.
 BOUNDS = {
     'default_principled': {
         'lpv': {'Combined': 0.051, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.010, 'Glossy Indirect': 0.542, 'Glossy Color': 0.020, 'Diffuse Light': 0.046, 'Diffuse Color match': 0.998},
@@ -69,16 +74,16 @@ BOUNDS = {
         'vct': {'Combined': 0.022, 'Diffuse Direct': 0.002, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.002, 'Diffuse Light': 0.021, 'Diffuse Color match': 0.998},
     },
     'window_room': {
-        'lpv': {'Combined': 0.163, 'Diffuse Direct': 0.138, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.213, 'Glossy Indirect': 0.402, 'Glossy Color': 0.018, 'Diffuse Light': 0.149, 'Diffuse Color match': 0.998},
-        'vct': {'Combined': 0.080, 'Diffuse Direct': 0.138, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.213, 'Glossy Indirect': 0.351, 'Glossy Color': 0.018, 'Diffuse Light': 0.145, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.080, 'Diffuse Direct': 0.115, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.192, 'Glossy Indirect': 0.402, 'Glossy Color': 0.018, 'Diffuse Light': 0.143, 'Diffuse Color match': 0.998},
+        'vct': {'Combined': 0.080, 'Diffuse Direct': 0.115, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.192, 'Glossy Indirect': 0.351, 'Glossy Color': 0.018, 'Diffuse Light': 0.138, 'Diffuse Color match': 0.998},
     },
     'rug_room': {
         'lpv': {'Combined': 0.051, 'Diffuse Direct': 0.003, 'Diffuse Indirect': 0.099, 'Diffuse Color': 0.002, 'Glossy Direct': 0.016, 'Glossy Indirect': 0.240, 'Glossy Color': 0.020, 'Diffuse Light': 0.044, 'Diffuse Color match': 0.998},
         'vct': {'Combined': 0.080, 'Diffuse Direct': 0.003, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.002, 'Glossy Direct': 0.016, 'Glossy Indirect': 0.294, 'Glossy Color': 0.020, 'Diffuse Light': 0.075, 'Diffuse Color match': 0.998},
     },
     'thin_walls': {
-        'lpv': {'Combined': 0.177, 'Diffuse Direct': 0.255, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.002, 'Glossy Direct': 0.435, 'Glossy Indirect': 0.539, 'Glossy Color': 0.025, 'Diffuse Light': 0.180, 'Diffuse Color match': 0.998},
-        'vct': {'Combined': 0.206, 'Diffuse Direct': 0.255, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.002, 'Glossy Direct': 0.435, 'Glossy Indirect': 0.504, 'Glossy Color': 0.025, 'Diffuse Light': 0.206, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.080, 'Diffuse Direct': 0.186, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.002, 'Glossy Direct': 0.358, 'Glossy Indirect': 0.539, 'Glossy Color': 0.025, 'Diffuse Light': 0.163, 'Diffuse Color match': 0.998},
+        'vct': {'Combined': 0.194, 'Diffuse Direct': 0.186, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.002, 'Glossy Direct': 0.358, 'Glossy Indirect': 0.504, 'Glossy Color': 0.025, 'Diffuse Light': 0.196, 'Diffuse Color match': 0.998},
     },
     'lamp_room': {
         'lpv': {'Combined': 0.080, 'Diffuse Direct': 0.043, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.002, 'Glossy Direct': 0.036, 'Glossy Indirect': 0.434, 'Glossy Color': 0.017, 'Emission': 0.002, 'Diffuse Light': 0.135, 'Diffuse Color match': 0.998},
@@ -89,8 +94,8 @@ BOUNDS = {
         'vct': {'Combined': 0.137, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.210, 'Diffuse Color': 0.004, 'Glossy Direct': 0.057, 'Glossy Indirect': 0.256, 'Glossy Color': 0.032, 'Diffuse Light': 0.143, 'Diffuse Color match': 0.998},
     },
     'outdoor': {
-        'lpv': {'Combined': 0.048, 'Diffuse Direct': 0.018, 'Diffuse Indirect': 0.254, 'Diffuse Color': 0.003, 'Glossy Direct': 0.056, 'Glossy Indirect': 0.620, 'Glossy Color': 0.033, 'Diffuse Light': 0.028, 'Diffuse Color match': 0.998},
-        'vct': {'Combined': 0.053, 'Diffuse Direct': 0.018, 'Diffuse Indirect': 0.310, 'Diffuse Color': 0.003, 'Glossy Direct': 0.056, 'Glossy Indirect': 0.684, 'Glossy Color': 0.033, 'Diffuse Light': 0.031, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.049, 'Diffuse Direct': 0.017, 'Diffuse Indirect': 0.254, 'Diffuse Color': 0.003, 'Glossy Direct': 0.051, 'Glossy Indirect': 0.620, 'Glossy Color': 0.033, 'Diffuse Light': 0.028, 'Diffuse Color match': 0.998},
+        'vct': {'Combined': 0.054, 'Diffuse Direct': 0.017, 'Diffuse Indirect': 0.310, 'Diffuse Color': 0.003, 'Glossy Direct': 0.051, 'Glossy Indirect': 0.684, 'Glossy Color': 0.033, 'Diffuse Light': 0.032, 'Diffuse Color match': 0.998},
     },
     'product_shot': {
         'lpv': {'Combined': 0.046, 'Diffuse Direct': 0.028, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.033, 'Glossy Indirect': 0.620, 'Glossy Color': 0.016, 'Diffuse Light': 0.042, 'Diffuse Color match': 0.996},
@@ -98,7 +103,7 @@ BOUNDS = {
     },
     'furnished': {
         'lpv': {'Combined': 0.080, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.039, 'Glossy Indirect': 0.256, 'Glossy Color': 0.025, 'Emission': 0.009, 'Diffuse Light': 0.093, 'Diffuse Color match': 0.998},
-        'vct': {'Combined': 0.080, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.039, 'Glossy Indirect': 0.237, 'Glossy Color': 0.025, 'Emission': 0.009, 'Diffuse Light': 0.088, 'Diffuse Color match': 0.998},
+        'vct': {'Combined': 0.080, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.039, 'Glossy Indirect': 0.236, 'Glossy Color': 0.025, 'Emission': 0.009, 'Diffuse Light': 0.087, 'Diffuse Color match': 0.998},
     },
     'cornell_animated': {
         'lpv': {'Combined': 0.048, 'Diffuse Direct': 0.014, 'Diffuse Indirect': 0.096, 'Diffuse Color': 0.002, 'Diffuse Light': 0.048, 'Diffuse Color match': 0.999},

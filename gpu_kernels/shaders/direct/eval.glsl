@@ -35,7 +35,10 @@ vec3 biased_point(ShadowView v, vec3 p, vec3 geo_n, vec3 to_light, float max_slo
 // max_slope caps the slope-scaled part of the offset (MAX_SLOPE for a light's own maps; 0 for the sky's many directions: a
 // grazing one pushed far off the surface would test a point beyond a thin wall, and acne in a few of them is
 // averaged away).
-float view_visibility_biased(int view_index, vec3 p, vec3 geo_n, vec3 to_light, float max_slope) {
+// `gap`: with PCF radius 0, how far (in stored depth) the nearest of the four texels read lies in front of p (≤ 0:
+// none does); 0 otherwise.
+float view_test(int view_index, vec3 p, vec3 geo_n, vec3 to_light, float max_slope, out float gap) {
+    gap = 0.0;
     ShadowView v = shadow_views[view_index];
     bool ortho = v.origin.w > 0.5;
     vec3 q = biased_point(v, p, geo_n, to_light, max_slope);
@@ -53,11 +56,13 @@ float view_visibility_biased(int view_index, vec3 p, vec3 geo_n, vec3 to_light, 
     int r = int(v.info.y);
     // PCF radius 0 (the sky's maps): shadowed if any of the four texels around p is — a wall meeting the floor
     // at a grazing angle to the view changes depth by more than its distance to p across one texel, so the nearest
-    // texel alone can read the wall as behind p and let the sky in at its foot. The sky's many directions are
-    // its penumbra, so this one-texel dilation of each direction's shadow costs nothing visible.
-    if (r == 0) {
-        vec4 g = textureGather(u_shadow_atlas, clamp(atlas_uv, lo, hi), depth);
-        return min(min(g.x, g.y), min(g.z, g.w));
+    // texel alone can read the wall as behind p and let the sky in at its foot (a wall seen edge-on covers no
+    // texel at all: only the dilation keeps the sky out along a zero-thickness wall parallel to a direction). It
+    // darkens each direction's visible region by a texel on every side: a few percent under a skylight.
+    if (r == 0) {  // the stored depths compared here as the atlas's "<=" comparison would
+        vec4 z = textureGather(u_shadow_depth, clamp(atlas_uv, lo, hi), 0);
+        gap = depth - min(min(z.x, z.y), min(z.z, z.w));
+        return gap <= 0.0 ? 1.0 : 0.0;
     }
     float sum = 0.0;
     for (int j = -r; j <= r; ++j)
@@ -66,6 +71,11 @@ float view_visibility_biased(int view_index, vec3 p, vec3 geo_n, vec3 to_light, 
             sum += texture(u_shadow_atlas, vec3(s, depth));
         }
     return sum / float((2 * r + 1) * (2 * r + 1));
+}
+
+float view_visibility_biased(int view_index, vec3 p, vec3 geo_n, vec3 to_light, float max_slope) {
+    float gap;
+    return view_test(view_index, p, geo_n, to_light, max_slope, gap);
 }
 
 float view_visibility(int view_index, vec3 p, vec3 geo_n, vec3 to_light) {
@@ -219,6 +229,13 @@ float polygon_visibility(GpuLight L, vec3 p, vec3 n, vec3 geo_n) {
 bool sky_direction(GpuLight L, int k, vec3 geo_n, out vec3 d) {
     d = shadow_views[int(L.params.y) + k].emitter.xyz;
     return dot(geo_n, d) >= 0.1;
+}
+
+// Metres per unit of an orthographic map's stored depth (its z is linear over its near–far span: 2 / |∇ ndc.z| of
+// its view–projection).
+float ortho_depth_scale(int view_index) {
+    mat4 m = shadow_views[view_index].view_projection;
+    return 2.0 / length(vec3(m[0][2], m[1][2], m[2][2]));
 }
 
 // Visibility of the sky light from its K directions d_k: the share of the cosine weight max(0, n·d_k) of the

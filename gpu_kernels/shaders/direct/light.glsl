@@ -29,7 +29,7 @@ uniform ivec2 u_size;
 uniform bool u_sky_cached;
 uniform sampler2D u_sky_shares;
 #if defined(MODE_SKY)
-layout(rg32f, binding = 2) uniform writeonly image2D u_sky_out;
+layout(rgba32f, binding = 2) uniform writeonly image2D u_sky_out;
 #endif
 
 // The sky light's visible shares at p, from one shadow test per direction (direct/eval.glsl sky_direction): x of
@@ -37,9 +37,12 @@ layout(rg32f, binding = 2) uniform writeonly image2D u_sky_out;
 // lobe's α² is widened by SKY_LOBE_SPREAD / K so that a mirror still averages its few nearest directions rather
 // than one.
 #define SKY_LOBE_SPREAD 2.0
-vec2 sky_shares(GpuLight L, vec3 p, vec3 n, vec3 geo_n, GlossyLobe lobe, vec3 v, bool lobe_seen) {
+vec2 sky_shares(GpuLight L, vec3 p, vec3 n, vec3 geo_n, GlossyLobe lobe, vec3 v, bool lobe_seen,
+                out float penumbra) {
     int samples = int(L.params.z);
+    penumbra = 0.0;
     if (samples == 0) return vec2(1.0);
+    float blocked = 0.0;
     float a2 = lobe.alpha * lobe.alpha + SKY_LOBE_SPREAD / float(samples);
     GlossyFresnel fresnel = glossy_fresnel_rows(u_material_lut, lobe.material, lobe.mu, lobe.base);
     vec2 wsum = vec2(0.0), vsum = vec2(0.0);
@@ -49,8 +52,18 @@ vec2 sky_shares(GpuLight L, vec3 p, vec3 n, vec3 geo_n, GlossyLobe lobe, vec3 v,
         vec2 w = vec2(max(dot(n, d), 0.0), lobe_seen ? sky_lobe_weight(lobe, fresnel, a2, n, v, d) : 0.0);
         if (max(w.x, w.y) <= 0.0) continue;
         wsum += w;
-        vsum += w * view_visibility_biased(int(L.params.y) + k, p, geo_n, d, 0.0);
+        float gap;   // in the map's stored depth
+        float seen = view_test(int(L.params.y) + k, p, geo_n, d, 0.0, gap);
+        vsum += w * seen;
+        if (gap > 0.0 && w.x > 0.0) {
+            penumbra += w.x / (gap * ortho_depth_scale(int(L.params.y) + k));
+            blocked += w.x;
+        }
     }
+    // A direction's cone (half-width √(4π/K)/2) at the blockers' distance: the width over which each of its hard
+    // shadows' edges should fade (direct/sky_filter.glsl). Their harmonic mean, so that a receiver beside a wall
+    // (many blockers near) keeps the contact shadow the wall casts rather than the far blockers' wide fade.
+    penumbra = penumbra > 0.0 ? 0.5 * sqrt(4.0 * PI / float(samples)) * blocked / penumbra : 0.0;
     return vec2(wsum.x > 0.0 ? vsum.x / wsum.x : 0.0, wsum.y > 0.0 ? vsum.y / wsum.y : 0.0);
 }
 
@@ -77,9 +90,11 @@ void main() {
     bool lobe_seen = has_glossy && lobe.mu > 0.0;
 #if defined(MODE_SKY)
     vec2 sky = vec2(0.0);
+    float penumbra = 0.0;
     for (int i = 0; i < u_light_count; ++i)
-        if (int(lights[i].color_type.w) == LIGHT_SKY) sky = sky_shares(lights[i], pos.xyz, n, geo_n, lobe, v, lobe_seen);
-    imageStore(u_sky_out, px, vec4(sky, 0.0, 0.0));
+        if (int(lights[i].color_type.w) == LIGHT_SKY)
+            sky = sky_shares(lights[i], pos.xyz, n, geo_n, lobe, v, lobe_seen, penumbra);
+    imageStore(u_sky_out, px, vec4(sky, penumbra, 0.0));
     return;
 #endif
     vec3 irradiance = vec3(0.0), reflected = vec3(0.0), world = vec3(0.0);
@@ -87,8 +102,9 @@ void main() {
         if (int(lights[i].color_type.w) == LIGHT_SKY) {
             // The world: irradiance π·L and, for any roughness, its reflection L (Glossy Color divided out; Cycles
             // counts the world a mirror shows as direct light too), each times its share of the sky that is seen.
+            float unused;
             vec2 shares = u_sky_cached ? texelFetch(u_sky_shares, px, 0).xy
-                                       : sky_shares(lights[i], pos.xyz, n, geo_n, lobe, v, lobe_seen);
+                                       : sky_shares(lights[i], pos.xyz, n, geo_n, lobe, v, lobe_seen, unused);
             irradiance += light_unshadowed(lights[i], pos.xyz, n) * shares.x;
             if (lobe_seen) world += lights[i].color_type.rgb * shares.y;
             continue;
