@@ -79,17 +79,6 @@ def test_numpy_dtype_mirrors_glsl_struct(struct):
     assert dt.itemsize == stride, f"numpy itemsize {dt.itemsize} != std430 stride {stride}"
 
 
-@pytest.fixture(scope="module")
-def gl():
-    moderngl = pytest.importorskip("moderngl")
-    try:
-        ctx = moderngl.create_standalone_context(backend="egl", require=430)
-    except Exception as exc:  # no EGL / GL 4.3 on this machine
-        pytest.skip(f"no OpenGL 4.3 context: {exc}")
-    yield ctx
-    ctx.release()
-
-
 READBACK = """
 #version 430 core
 #include "common/lights.glsl"
@@ -115,7 +104,8 @@ void main() {
 """
 
 
-def test_gpu_reads_numpy_records_field_for_field(gl, tmp_path):
+def test_gpu_reads_numpy_records_field_for_field(gl_context, tmp_path):
+    gl = gl_context
     rng = np.random.default_rng(7)
     lights = np.zeros(3, lb.LIGHT_DTYPE)
     for name in lb.LIGHT_DTYPE.names:

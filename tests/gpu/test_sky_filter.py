@@ -8,26 +8,12 @@ import pytest
 
 from bounce_gi.gpu_kernels.direct.gbuffer import GBuffer
 from bounce_gi.gpu_kernels.direct.lighting import filter_sky_shares
-from bounce_gi.gpu_kernels.gl.programs import ProgramCache
 
 W, H = 64, 16
 FLOOR = 32          # columns 0..31: the floor (z = 0, normal +z); 32..63: a wall (x = 0.64 m, normal −x)
 PIXEL = 0.02        # m per pixel on the floor
 EDGE = 16           # the floor's share is 1 left of this column, 0 from it on
 HALF_WIDTH = 0.1    # m: the penumbra's half-width every pixel carries (5 pixels on the floor)
-
-
-@pytest.fixture(scope="module")
-def gl():
-    moderngl = pytest.importorskip("moderngl")
-    try:
-        ctx = moderngl.create_standalone_context(backend="egl", require=430)
-    except Exception as exc:  # no EGL / GL 4.3 on this machine
-        pytest.skip(f"no OpenGL 4.3 context: {exc}")
-    programs = ProgramCache(ctx)
-    yield ctx, programs
-    programs.release()
-    ctx.release()
 
 
 def _inputs(half_width):

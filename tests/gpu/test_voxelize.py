@@ -8,24 +8,10 @@ from bounce_gi.gpu_kernels.direct import geometry as direct
 from bounce_gi.gpu_kernels.voxel import tessellate as vt
 from bounce_gi.gpu_kernels.voxel import voxelize as vz
 from bounce_gi.gpu_kernels.common.grid import LATTICE_PHASE, Grid
-from bounce_gi.gpu_kernels.gl.programs import ProgramCache
 from bounce_gi.gpu_kernels.scene import Material, Scene, Texture
 
 trimesh = pytest.importorskip("trimesh")
 MODES = ("raster", "tessellation")
-
-
-@pytest.fixture(scope="module")
-def gl():
-    moderngl = pytest.importorskip("moderngl")
-    try:
-        ctx = moderngl.create_standalone_context(backend="egl", require=430)
-    except Exception as exc:  # no EGL / GL 4.3 on this machine
-        pytest.skip(f"no OpenGL 4.3 context: {exc}")
-    programs = ProgramCache(ctx)
-    yield ctx, programs
-    programs.release()
-    ctx.release()
 
 
 def make_scene(positions, material_index=None, materials=None, uvs=None, textures=()):
