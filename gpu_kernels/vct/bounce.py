@@ -13,7 +13,7 @@ from .inject import face_flux
 from .mipmap import build_volumes
 from .settings import VctSettings
 from .trace import bind_cones
-from .volumes import ConeVolumes, Faces, bind_volumes
+from .volumes import ConeVolumes, Faces, bind_volumes, gather_levels
 
 
 def bounce(ctx, programs, vox, direct_faces: Faces, volumes: ConeVolumes, s: VctSettings) -> ConeVolumes:
@@ -38,7 +38,8 @@ def bounce(ctx, programs, vox, direct_faces: Faces, volumes: ConeVolumes, s: Vct
         unit = bind_samplers(prog, "u_direct", direct_faces.textures, unit)
         unit = bind_samplers(prog, "u_centroid", direct_faces.centroids, unit)
         bind_samplers(prog, "u_albedo", [vox.albedo], unit)
-        bind_cones(prog, grid, volumes.levels, replace(s, diffuse_cones=s.bounce_cones or s.diffuse_cones))
+        bind_cones(prog, grid, min(volumes.levels, gather_levels(s.resolution)),
+                   replace(s, diffuse_cones=s.bounce_cones or s.diffuse_cones))
         for i, t in enumerate(faces.textures):
             t.bind_to_image(i, read=False, write=True)
         dispatch(prog, grid.size)
