@@ -64,14 +64,20 @@ from examples import references  # noqa: E402
 # (vct/volumes.py gather_levels: coarser texels straddle a room's walls and let cones out of it): Combined / Diffuse
 # Indirect many_lights 0.109 / 0.167 -> 0.090 / 0.140, thin_walls 0.100 / 0.112 -> 0.075 / 0.086, rug_room 0.059 /
 # 0.113 -> 0.043 / 0.082; the others within 0.002.
+# 2026-12-05 (later): the VCT rows re-measured after the per-pixel sub-rays stopped stepping over surfaces that are
+# not aligned with the grid (vct/crossing.glsl: each surface's depth read at both ends of a step, one step's coverages
+# added, the finer read in the sub-ray's own column). Diffuse Indirect: outdoor 0.275 -> 0.237, product_shot 0.138 ->
+# 0.128; metals 0.151 -> 0.180 (1.07x -> 1.11x Cycles: its spheres, half invisible to the cones before, now bounce
+# their light, and the transport treats a metal's reflection as diffuse), many_lights 0.140 -> 0.148; others within
+# 0.005. The closed sphere and the turned room of tests/gpu/test_vct.py are what it was for.
 BOUNDS = {
     'default_principled': {
         'lpv': {'Combined': 0.051, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.010, 'Glossy Indirect': 0.542, 'Glossy Color': 0.020, 'Diffuse Light': 0.046, 'Diffuse Color match': 0.998},
-        'vct': {'Combined': 0.041, 'Diffuse Direct': 0.010, 'Diffuse Indirect': 0.124, 'Diffuse Color': 0.003, 'Glossy Direct': 0.010, 'Glossy Indirect': 0.386, 'Glossy Color': 0.020, 'Diffuse Light': 0.038, 'Diffuse Color match': 0.998},
+        'vct': {'Combined': 0.042, 'Diffuse Direct': 0.010, 'Diffuse Indirect': 0.125, 'Diffuse Color': 0.003, 'Glossy Direct': 0.010, 'Glossy Indirect': 0.386, 'Glossy Color': 0.020, 'Diffuse Light': 0.038, 'Diffuse Color match': 0.998},
     },
     'metals': {
         'lpv': {'Combined': 0.061, 'Diffuse Direct': 0.014, 'Diffuse Indirect': 0.246, 'Diffuse Color': 0.003, 'Glossy Direct': 0.034, 'Glossy Indirect': 0.634, 'Glossy Color': 0.013, 'Diffuse Light': 0.028, 'Diffuse Color match': 0.998},
-        'vct': {'Combined': 0.046, 'Diffuse Direct': 0.014, 'Diffuse Indirect': 0.216, 'Diffuse Color': 0.003, 'Glossy Direct': 0.033, 'Glossy Indirect': 0.542, 'Glossy Color': 0.013, 'Diffuse Light': 0.029, 'Diffuse Color match': 0.998},
+        'vct': {'Combined': 0.046, 'Diffuse Direct': 0.014, 'Diffuse Indirect': 0.245, 'Diffuse Color': 0.003, 'Glossy Direct': 0.033, 'Glossy Indirect': 0.525, 'Glossy Color': 0.013, 'Diffuse Light': 0.031, 'Diffuse Color match': 0.998},
     },
     'textured': {
         'lpv': {'Combined': 0.017, 'Diffuse Direct': 0.002, 'Diffuse Indirect': 0.124, 'Diffuse Color': 0.002, 'Diffuse Light': 0.017, 'Diffuse Color match': 0.998},
@@ -79,39 +85,39 @@ BOUNDS = {
     },
     'window_room': {
         'lpv': {'Combined': 0.080, 'Diffuse Direct': 0.115, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.192, 'Glossy Indirect': 0.402, 'Glossy Color': 0.018, 'Diffuse Light': 0.143, 'Diffuse Color match': 0.998},
-        'vct': {'Combined': 0.080, 'Diffuse Direct': 0.115, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.192, 'Glossy Indirect': 0.354, 'Glossy Color': 0.018, 'Diffuse Light': 0.142, 'Diffuse Color match': 0.998},
+        'vct': {'Combined': 0.080, 'Diffuse Direct': 0.115, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.192, 'Glossy Indirect': 0.358, 'Glossy Color': 0.018, 'Diffuse Light': 0.142, 'Diffuse Color match': 0.998},
     },
     'rug_room': {
         'lpv': {'Combined': 0.051, 'Diffuse Direct': 0.003, 'Diffuse Indirect': 0.099, 'Diffuse Color': 0.002, 'Glossy Direct': 0.016, 'Glossy Indirect': 0.240, 'Glossy Color': 0.020, 'Diffuse Light': 0.044, 'Diffuse Color match': 0.998},
-        'vct': {'Combined': 0.072, 'Diffuse Direct': 0.003, 'Diffuse Indirect': 0.140, 'Diffuse Color': 0.002, 'Glossy Direct': 0.016, 'Glossy Indirect': 0.264, 'Glossy Color': 0.020, 'Diffuse Light': 0.061, 'Diffuse Color match': 0.998},
+        'vct': {'Combined': 0.072, 'Diffuse Direct': 0.003, 'Diffuse Indirect': 0.142, 'Diffuse Color': 0.002, 'Glossy Direct': 0.016, 'Glossy Indirect': 0.264, 'Glossy Color': 0.020, 'Diffuse Light': 0.062, 'Diffuse Color match': 0.998},
     },
     'thin_walls': {
         'lpv': {'Combined': 0.080, 'Diffuse Direct': 0.186, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.002, 'Glossy Direct': 0.358, 'Glossy Indirect': 0.539, 'Glossy Color': 0.025, 'Diffuse Light': 0.163, 'Diffuse Color match': 0.998},
-        'vct': {'Combined': 0.080, 'Diffuse Direct': 0.186, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.002, 'Glossy Direct': 0.358, 'Glossy Indirect': 0.494, 'Glossy Color': 0.025, 'Diffuse Light': 0.171, 'Diffuse Color match': 0.998},
+        'vct': {'Combined': 0.080, 'Diffuse Direct': 0.186, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.002, 'Glossy Direct': 0.358, 'Glossy Indirect': 0.494, 'Glossy Color': 0.025, 'Diffuse Light': 0.168, 'Diffuse Color match': 0.998},
     },
     'lamp_room': {
         'lpv': {'Combined': 0.080, 'Diffuse Direct': 0.043, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.002, 'Glossy Direct': 0.036, 'Glossy Indirect': 0.434, 'Glossy Color': 0.017, 'Emission': 0.002, 'Diffuse Light': 0.135, 'Diffuse Color match': 0.998},
-        'vct': {'Combined': 0.080, 'Diffuse Direct': 0.043, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.002, 'Glossy Direct': 0.036, 'Glossy Indirect': 0.383, 'Glossy Color': 0.017, 'Emission': 0.002, 'Diffuse Light': 0.132, 'Diffuse Color match': 0.998},
+        'vct': {'Combined': 0.080, 'Diffuse Direct': 0.043, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.002, 'Glossy Direct': 0.036, 'Glossy Indirect': 0.384, 'Glossy Color': 0.017, 'Emission': 0.002, 'Diffuse Light': 0.135, 'Diffuse Color match': 0.998},
     },
     'many_lights': {
         'lpv': {'Combined': 0.072, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.108, 'Diffuse Color': 0.004, 'Glossy Direct': 0.057, 'Glossy Indirect': 0.214, 'Glossy Color': 0.032, 'Diffuse Light': 0.074, 'Diffuse Color match': 0.998},
-        'vct': {'Combined': 0.118, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.004, 'Glossy Direct': 0.057, 'Glossy Indirect': 0.240, 'Glossy Color': 0.032, 'Diffuse Light': 0.124, 'Diffuse Color match': 0.998},
+        'vct': {'Combined': 0.122, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.004, 'Glossy Direct': 0.057, 'Glossy Indirect': 0.240, 'Glossy Color': 0.032, 'Diffuse Light': 0.130, 'Diffuse Color match': 0.998},
     },
     'outdoor': {
         'lpv': {'Combined': 0.049, 'Diffuse Direct': 0.017, 'Diffuse Indirect': 0.254, 'Diffuse Color': 0.003, 'Glossy Direct': 0.051, 'Glossy Indirect': 0.620, 'Glossy Color': 0.033, 'Diffuse Light': 0.028, 'Diffuse Color match': 0.998},
-        'vct': {'Combined': 0.054, 'Diffuse Direct': 0.017, 'Diffuse Indirect': 0.310, 'Diffuse Color': 0.003, 'Glossy Direct': 0.051, 'Glossy Indirect': 0.684, 'Glossy Color': 0.033, 'Diffuse Light': 0.032, 'Diffuse Color match': 0.998},
+        'vct': {'Combined': 0.050, 'Diffuse Direct': 0.017, 'Diffuse Indirect': 0.273, 'Diffuse Color': 0.003, 'Glossy Direct': 0.051, 'Glossy Indirect': 0.666, 'Glossy Color': 0.033, 'Diffuse Light': 0.029, 'Diffuse Color match': 0.998},
     },
     'product_shot': {
         'lpv': {'Combined': 0.046, 'Diffuse Direct': 0.028, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.033, 'Glossy Indirect': 0.620, 'Glossy Color': 0.016, 'Diffuse Light': 0.042, 'Diffuse Color match': 0.996},
-        'vct': {'Combined': 0.047, 'Diffuse Direct': 0.028, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.033, 'Glossy Indirect': 0.496, 'Glossy Color': 0.016, 'Diffuse Light': 0.043, 'Diffuse Color match': 0.996},
+        'vct': {'Combined': 0.046, 'Diffuse Direct': 0.028, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.033, 'Glossy Indirect': 0.490, 'Glossy Color': 0.016, 'Diffuse Light': 0.042, 'Diffuse Color match': 0.996},
     },
     'furnished': {
         'lpv': {'Combined': 0.080, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.039, 'Glossy Indirect': 0.256, 'Glossy Color': 0.025, 'Emission': 0.009, 'Diffuse Light': 0.093, 'Diffuse Color match': 0.998},
-        'vct': {'Combined': 0.075, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.133, 'Diffuse Color': 0.003, 'Glossy Direct': 0.039, 'Glossy Indirect': 0.231, 'Glossy Color': 0.025, 'Emission': 0.009, 'Diffuse Light': 0.077, 'Diffuse Color match': 0.998},
+        'vct': {'Combined': 0.078, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.139, 'Diffuse Color': 0.003, 'Glossy Direct': 0.039, 'Glossy Indirect': 0.235, 'Glossy Color': 0.025, 'Emission': 0.009, 'Diffuse Light': 0.080, 'Diffuse Color match': 0.998},
     },
     'cornell_animated': {
         'lpv': {'Combined': 0.048, 'Diffuse Direct': 0.014, 'Diffuse Indirect': 0.096, 'Diffuse Color': 0.002, 'Diffuse Light': 0.048, 'Diffuse Color match': 0.999},
-        'vct': {'Combined': 0.065, 'Diffuse Direct': 0.012, 'Diffuse Indirect': 0.141, 'Diffuse Color': 0.002, 'Diffuse Light': 0.066, 'Diffuse Color match': 0.999},
+        'vct': {'Combined': 0.064, 'Diffuse Direct': 0.012, 'Diffuse Indirect': 0.139, 'Diffuse Color': 0.002, 'Diffuse Light': 0.064, 'Diffuse Color match': 0.999},
     },
 }
 

@@ -21,6 +21,7 @@ from bounce_gi.gpu_kernels.settings import RenderSettings
 from bounce_gi.gpu_kernels.gl.programs import ProgramCache
 from bounce_gi.gpu_kernels.scene import Camera, Light, Material, Scene, World
 from bounce_gi.gpu_kernels.common import camera as cam
+from support.synthetic import sphere_scene
 
 CLAMPED_COSINE = lambda n: np.array([0.886226925, -1.023326708 * n[1], 1.023326708 * n[2], -1.023326708 * n[0]])
 
@@ -70,20 +71,8 @@ def test_light_leaves_through_open_borders_and_is_never_created(engine):
     assert fluxes[-1] < 0.01 * 5.0
 
 
-def _sphere_scene(subdivisions=3, radius=1.0, albedo=0.5, power=100.0, eye=(0.0, 0.0, 0.0)):
-    import trimesh
-
-    m = trimesh.creation.icosphere(subdivisions=subdivisions, radius=radius)
-    pos = m.vertices[m.faces][:, ::-1].astype(np.float32)  # reversed winding: faces point inward
-    nrm = (-pos / radius).astype(np.float32)
-    cam_to_world = np.linalg.inv(cam.look_at(eye, np.asarray(eye) + (1, 0, 0), (0, 0, 1)))
-    return Scene(pos, nrm, np.zeros((len(pos), 3, 2), np.float32), np.zeros(len(pos), np.int32),
-                 [Material("wall", (albedo,) * 3)], [], [Light("bulb", "POINT", (1, 1, 1), power, np.eye(4))],
-                 World(), Camera(cam_to_world, lens=18.0))
-
-
 def test_injection_does_not_depend_on_rsm_resolution(engine):
-    scene = _sphere_scene()
+    scene = sphere_scene()
     injected = []
     for res in (64, 128):
         r = engine.render(scene, RenderSettings("lpv", 64, 48, lpv=LpvSettings(rsm_resolution=res, bounces=1,
@@ -140,7 +129,7 @@ def test_closed_sphere_one_bounce_against_the_analytic_irradiance(engine, transp
     today's level (0.65–1.15; spread within 0.45–1.5 of the mean: 0.49–1.57 measured since the lattice's boundaries
     moved to (k + 1/3) cells, common/grid.LATTICE_PHASE, 0.53–1.47 before) as a regression bound.
     """
-    scene = _sphere_scene(subdivisions=4)
+    scene = sphere_scene(subdivisions=4)
     r = engine.render(scene, RenderSettings("lpv", 96, 72, lpv=LpvSettings(resolution=32, bounces=1,
                                                                               transport=transport)))
     e1 = 0.5 * 100.0 / (4 * math.pi)
@@ -161,7 +150,7 @@ def test_cascades_agree_with_a_single_grid_where_they_overlap(engine):
     of the coarse one, so the two estimates differ by discretisation only. The camera sits 0.3 m from the wall it
     looks at, so the finer cascades (centred on it) cover what it sees. Bound: means within 35% of each other
     (measured: see the printout), both light every pixel, and the 3-cascade image is not the 1-cascade one."""
-    scene = _sphere_scene(subdivisions=4, eye=(0.7, 0.0, 0.0))
+    scene = sphere_scene(subdivisions=4, eye=(0.7, 0.0, 0.0))
     images = []
     means = []
     for cascades in (1, 3):
@@ -198,7 +187,7 @@ def test_world_light_is_direct_on_an_open_floor_and_absent_inside_a_closed_spher
     np.testing.assert_allclose(direct, 1.0, atol=1e-5)
     assert r.passes["Diffuse Indirect"][hit].max() < 1e-6
 
-    sphere = _sphere_scene(subdivisions=3)
+    sphere = sphere_scene(subdivisions=3)
     sphere.lights = []
     sphere.world = World((1.0, 1.0, 1.0))
     sphere.materials[0].emission = (0.0, 0.0, 0.0)
@@ -245,7 +234,7 @@ def test_intensity_aware_rsm_downsampling_keeps_the_flux(engine, downsample):
     """Clustering k×k RSM texels into one VPL (Kaplanyan 2009, §N.5.2) sums their flux: the injected total must not change
     (float32 sums: 1e-4), and the image may change only by where the merged VPLs sit (means within 10%). The
     setting is the propagating transport's (the gather clusters to its own VPL budget, test_lpv_gather.py)."""
-    scene = _sphere_scene()
+    scene = sphere_scene()
     results = []
     for k in (1, downsample):
         r = engine.render(scene, RenderSettings("lpv", 64, 48, lpv=LpvSettings(

@@ -15,7 +15,7 @@ from bounce_gi.gpu_kernels.lpv.gather import VPL_DTYPE, merge
 from bounce_gi.gpu_kernels.settings import RenderSettings
 from bounce_gi.gpu_kernels.scene import Light, Material
 from support.synthetic import box_quads, lit_patch_error, lit_patch_scene, quad_scene
-from test_lpv import _sphere_scene
+from support.synthetic import sphere_scene
 
 
 @pytest.fixture(scope="module")
@@ -55,7 +55,7 @@ def test_the_vpl_list_carries_the_injected_flux(engine):
     """The gather's VPLs (clustered to fit `gather_vpls`), the transfer's clusters and the propagation's
     injection read the same RSM: the same flux, whatever the budget (float32 sums: 1e-4; inside a closed sphere
     none escapes)."""
-    scene = _sphere_scene()
+    scene = sphere_scene()
     propagated = _render(engine, scene, transport="propagate", bounces=1, max_iterations=4)
     flux = [propagated.info["cascades"][0]["injected_flux"]]
     for budget in (64, 512):
@@ -83,7 +83,7 @@ def test_closed_sphere_bounce_series_against_the_analytic_irradiance(engine, tra
     up to half a voxel, and receivers in a cluster's own plane are skipped), which the ratio measures.
     The transfer sums every bounce (`gathered` does not apply) with the same kernel and the same bounds."""
     rho = 0.5
-    r = _render(engine, _sphere_scene(subdivisions=4), resolution=32, bounces=bounces, gathered_bounces=gathered,
+    r = _render(engine, sphere_scene(subdivisions=4), resolution=32, bounces=bounces, gathered_bounces=gathered,
                 transport=transport)
     e1 = rho * 100.0 / (4 * math.pi)
     expected = e1 * (1 - rho ** bounces) / (1 - rho)

@@ -18,7 +18,7 @@ from bounce_gi.gpu_kernels.settings import RenderSettings
 from bounce_gi.gpu_kernels.gl.programs import ProgramCache
 from bounce_gi.gpu_kernels.scene import Camera, Light, Material, Scene, World
 
-from test_lpv import _sphere_scene
+from support.synthetic import sphere_scene
 
 
 @pytest.fixture(scope="module")
@@ -80,7 +80,7 @@ def test_downsampling_sums_children_exactly(engine):
 
 def test_downsampling_conserves_the_injected_flux_in_a_scene(engine):
     """Inside the closed sphere at 32³, 4 levels: Σ c0·2√π is the same on every level (float32: 1e-5)."""
-    engine.render(_sphere_scene(), RenderSettings("lpv", 32, 24, lpv=LpvSettings(resolution=32, octree_levels=4)))
+    engine.render(sphere_scene(), RenderSettings("lpv", 32, 24, lpv=LpvSettings(resolution=32, octree_levels=4)))
     fluxes = _entry(engine, "lpv_downsample", lpv_octree.level_fluxes)
     print("flux per level:", fluxes)
     assert fluxes[0] > 0
@@ -116,7 +116,7 @@ def test_index_volume_is_fine_at_geometry_and_coarse_in_empty_space(engine):
 def test_merge_copies_o0_where_the_index_is_0_and_scales_coarse_levels(engine):
     """M(x) = A_0(x) where I(x) = 0 (exactly: a copy), A_i(x >> i)/4^i elsewhere (float32 scaling by a power of 2:
     exact too). Sphere at 16³, 3 levels."""
-    engine.render(_sphere_scene(), RenderSettings("lpv", 32, 24, lpv=LpvSettings(resolution=16, octree_levels=3)))
+    engine.render(sphere_scene(), RenderSettings("lpv", 32, 24, lpv=LpvSettings(resolution=16, octree_levels=3)))
     merged, index = _entry(engine, "lpv_merge", lambda m: (
         lpv_octree.read_volumes(m.accum, m.grid),
         np.frombuffer(m.index.read(), np.float32).reshape(m.grid.shape_zyx).astype(int)))
@@ -134,7 +134,7 @@ def test_one_level_equals_the_uniform_lpv(engine):
     """octree_levels=1 runs the octree path (no coarser level, merge = copy) and must give the uniform LPV with the
     same k steps, one bounce and the intensity lookup: the same shaders on the same data, so equal to float32
     rounding (1e-6 relative)."""
-    scene = _sphere_scene()
+    scene = sphere_scene()
     a = engine.render(scene, RenderSettings("lpv", 48, 36, lpv=LpvSettings(
         resolution=16, octree_levels=1, octree_iterations=6)))
     b = engine.render(scene, RenderSettings("lpv", 48, 36, lpv=LpvSettings(
@@ -151,7 +151,7 @@ def test_octree_light_level_against_many_uniform_iterations(engine):
     propagated k = 4 steps; the coarse levels carry light across the empty interior but the merge (M = S, Eq. 1)
     never shows it at a surface. Bound: octree/uniform in [0.2, 0.5] (today 0.28) — a change that lets coarse
     levels light surfaces should raise it and move this bound."""
-    scene = _sphere_scene(subdivisions=4)
+    scene = sphere_scene(subdivisions=4)
     e1 = 0.5 * 100.0 / (4 * math.pi)
     means = {}
     for name, kw in (("uniform64", dict(lookup="intensity", bounces=1, max_iterations=64, epsilon=0.0)),
@@ -169,7 +169,7 @@ def test_octree_error_metric_is_zero_before_propagation_and_grows(engine):
     """Olovsson and Doggett 2013, §4.1: right after downsampling every O_i equals Ô_i (the downsampled O_{i-1}), in merge units — so
     e_abs = 0 (float32: 1e-6 of the largest coefficient) — and propagation makes the levels diverge (e_abs > 0)."""
     settings = LpvSettings(resolution=16, octree_levels=3)
-    engine.render(_sphere_scene(), RenderSettings("lpv", 32, 24, lpv=settings))
+    engine.render(sphere_scene(), RenderSettings("lpv", 32, 24, lpv=settings))
 
     def run(ctx):
         cache = engine.pipeline.cache

@@ -130,3 +130,17 @@ def triangle_projected_solid_angles(points, normals, tris):
         s = np.linalg.norm(c, axis=-1)
         total = total + np.arctan2(s, (a * b).sum(-1)) * (n * c).sum(-1) / np.maximum(s, 1e-300)
     return 0.5 * np.abs(total)
+
+
+def sphere_scene(subdivisions=3, radius=1.0, albedo=0.5, power=100.0, eye=(0.0, 0.0, 0.0)):
+    """A closed icosphere of `radius` and `albedo`, faces inward, a point light of `power` W at its centre, the
+    camera at `eye` looking along +x."""
+    import trimesh
+
+    m = trimesh.creation.icosphere(subdivisions=subdivisions, radius=radius)
+    pos = m.vertices[m.faces][:, ::-1].astype(np.float32)  # reversed winding: faces point inward
+    nrm = (-pos / radius).astype(np.float32)
+    cam_to_world = np.linalg.inv(cam.look_at(eye, np.asarray(eye) + (1, 0, 0), (0, 0, 1)))
+    return Scene(pos, nrm, np.zeros((len(pos), 3, 2), np.float32), np.zeros(len(pos), np.int32),
+                 [Material("wall", (albedo,) * 3)], [], [Light("bulb", "POINT", (1, 1, 1), power, np.eye(4))],
+                 World(), Camera(cam_to_world, lens=18.0))
