@@ -69,7 +69,7 @@ from examples import references  # noqa: E402
 # added, the finer read in the sub-ray's own column). Diffuse Indirect: outdoor 0.275 -> 0.237, product_shot 0.138 ->
 # 0.128; metals 0.151 -> 0.180 (1.07x -> 1.11x Cycles: its spheres, half invisible to the cones before, now bounce
 # their light, and the transport treats a metal's reflection as diffuse), many_lights 0.140 -> 0.148; others within
-# 0.005. The closed sphere and the turned room of tests/gpu/test_vct.py are what it was for.
+# 0.005. The closed sphere and the turned room of tests/gpu/test_vct_off_grid.py are what it was for.
 BOUNDS = {
     'default_principled': {
         'lpv': {'Combined': 0.051, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.010, 'Glossy Indirect': 0.542, 'Glossy Color': 0.020, 'Diffuse Light': 0.046, 'Diffuse Color match': 0.998},

@@ -29,7 +29,7 @@
 // whichever finer texel holds it in the sub-ray's column, not the one holding the texel's mean depth. Measured, the
 // share of the closed white furnace's light that escaped the per-pixel cones (64³, one bounce): 2.0% → 2.0% as
 // built, 29% → 9% turned 30° about z (its Diffuse Indirect 0.67 → 0.86 of the exact value); inside a closed sphere
-// lit from its centre the first bounce is 0.54 → 0.89 of the exact value (tests/gpu/test_vct.py).
+// lit from its centre the first bounce is 0.54 → 0.89 of the exact value (tests/gpu/test_vct_off_grid.py).
 // Consequences: a surface behind a sub-ray's start is never crossed, so cones need no level cap (the level follows
 // the diameter, Freed 2018, listing 4.1); a sub-ray level with a floor never meets it, one tilted down meets it where
 // it actually gets there; a sub-ray is absorbed only by surfaces it passes through, so one leaving the grid sees the
