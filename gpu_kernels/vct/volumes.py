@@ -32,8 +32,8 @@ def gather_levels(resolution: int) -> int:
     keeps per gathered bounce (tests/stress/test_furnace.py's box), all levels → these: 16³ 0.934 → 0.989, 64³
     0.967 → 0.990, 128³ 0.976 → 0.992. The per-pixel cones keep every level: capped there too, cornell_animated's
     Diffuse Indirect came out worse (0.097 → 0.136 against Cycles) at 1.4× the trace's time."""
-    finest = int(math.floor(math.log2(max(resolution / GATHER_TEXEL_FRACTION, 1.0))))
-    return max(1, min(mip_levels(resolution), finest + 1))
+    coarsest = int(math.floor(math.log2(max(resolution / GATHER_TEXEL_FRACTION, 1.0))))
+    return max(1, min(mip_levels(resolution), coarsest + 1))
 
 
 def vct_grid(scene: Scene, settings: VctSettings) -> Grid:
