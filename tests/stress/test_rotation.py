@@ -3,9 +3,10 @@
 voxel grids stay aligned with the world's axes, so a room that is not is a staircase of partly covered voxels.
 
 Direct light has no voxel grid: turned 30° its image differs by 7·10⁻⁴ in rel-L1 (its shadow maps' texels fall
-elsewhere on the turned walls); bound 0.002. The voxel methods do not turn as well yet: these tests hold today's measured error
-of Diffuse Indirect (rel-L1 against the unturned room, and the ratio of their means) as regression bounds, the room
-at 80 × 60 with each method's default grid (LPV 32³, VCT 64³) — the turned room's walls are what users' rooms are.
+elsewhere on the turned walls); bound 0.002. The voxel methods do not turn as well yet: these tests hold today's
+measured error of Diffuse Indirect (rel-L1 against the unturned room, and the ratio of their means) as regression
+bounds, the room at 80 × 60 with each method's default grid (LPV 32³, VCT 64³) — the turned room's walls are what
+users' rooms are.
 Measured 2026-12-05 (the turned room / the unturned one, Diffuse Indirect):
   LPV: 10° 0.878 (rel-L1 0.122), 30° 0.863 (0.137);
   VCT: 10° 0.880 (0.120), 30° 0.634 (0.366). Before the VCT's sub-rays read surfaces' depth at both ends of a step
@@ -15,16 +16,12 @@ Bounds: the measured rel-L1 + 0.02 and the measured ratio − 0.03 (llvmpipe ren
 margin is for another driver's rounding), so a change that turns the rooms worse fails, and one that fixes them
 should tighten these numbers toward 0 and 1.
 """
-import math
-from dataclasses import replace
-
-import numpy as np
 import pytest
 
 from bounce_gi.gpu_kernels.lpv.settings import LpvSettings
 from bounce_gi.gpu_kernels.settings import RenderSettings
 from bounce_gi.gpu_kernels.vct.settings import VctSettings
-from support.stress import box_room, check_sane, rel_l1
+from support.stress import box_room, check_sane, rel_l1, turned
 
 SIZE = (80, 60)
 # (rel-L1 bound, lowest ratio of the means) per method and angle
@@ -32,19 +29,6 @@ BOUNDS = {("none", 30): (0.002, 0.998),
           ("lpv", 10): (0.142, 0.848), ("lpv", 30): (0.157, 0.833),
           ("vct", 10): (0.140, 0.850), ("vct", 30): (0.386, 0.604)}
 _reference = {}
-
-
-def turned(scene, degrees: float):
-    """`scene` turned `degrees` about the world's z axis: triangles, normals, lights and camera."""
-    c, s = math.cos(math.radians(degrees)), math.sin(math.radians(degrees))
-    m = np.eye(4, dtype=np.float32)
-    m[:2, :2] = ((c, -s), (s, c))
-    r = m[:3, :3]
-    lights = [replace(l, matrix_world=(m @ np.asarray(l.matrix_world, np.float32)).astype(np.float32))
-              for l in scene.lights]
-    return replace(scene, positions=(scene.positions @ r.T).astype(np.float32),
-                   normals=(scene.normals @ r.T).astype(np.float32), lights=lights,
-                   camera=replace(scene.camera, matrix_world=(m @ scene.camera.matrix_world).astype(np.float32)))
 
 
 def render(engine, method, degrees):

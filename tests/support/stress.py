@@ -80,6 +80,19 @@ def furnace(albedo: float, le: float = 1.0):
                       (0.3, 1.0, -0.2))
 
 
+def turned(scene, degrees: float):
+    """`scene` turned `degrees` about the world's z axis: triangles, normals, lights and camera."""
+    c, s = math.cos(math.radians(degrees)), math.sin(math.radians(degrees))
+    m = np.eye(4, dtype=np.float32)
+    m[:2, :2] = ((c, -s), (s, c))
+    r = m[:3, :3]
+    lights = [replace(l, matrix_world=(m @ np.asarray(l.matrix_world, np.float32)).astype(np.float32))
+              for l in scene.lights]
+    return replace(scene, positions=(scene.positions @ r.T).astype(np.float32),
+                   normals=(scene.normals @ r.T).astype(np.float32), lights=lights,
+                   camera=replace(scene.camera, matrix_world=(m @ scene.camera.matrix_world).astype(np.float32)))
+
+
 def direct_bound(scene) -> float:
     """An upper bound of irradiance / π anywhere on the scene's surfaces (before reflection): the lights' bounds
     added up, plus the brightest emission and the world (a surface sees at most radiance L all round: E/π ≤ L).

@@ -14,12 +14,12 @@
 // (the centroid radius of the outer ring when the cone's disc is cut into equal areas, vct.subray_radius), each
 // with its own transmittance T_j and equal weight. The samples are shared: at every step the three texels along
 // each axis around the sample are read at the cone's level, and the layer volume (vct/mipmap.glsl MODE_LAYERS) says
-// where, along that axis, each texel's surfaces lie (the τ-weighted mean position), in the columns through the axis's
-// positions at the step's start and end. A sub-ray meets those surfaces iff it is behind that position at the start
-// and not at the end; then it gathers α·S of what is left of it (T_j − α), with α and S read where it crosses, one
-// level finer than the cone (about a sub-ray's own width; the cone's level blurred a lit patch over its neighbours'
-// sub-rays: a 3 × 2.5 m lit patch seen from a plate 3 m above came out 1.23× the exact integral read at the cone's
-// level, 1.01× one level finer), over both finer texels of the crossed one in the sub-ray's own column.
+// where, along that axis, each texel's surfaces lie (the τ-weighted mean position), in the columns through the
+// axis's positions at the step's start and end. A sub-ray meets those surfaces iff it is behind that position at
+// the start and not at the end; then it gathers α·S of what is left of it (T_j − α), with α and S read where it
+// crosses, one level finer than the cone (about a sub-ray's own width; the cone's level blurred a lit patch over its
+// neighbours' sub-rays: a 3 × 2.5 m lit patch seen from a plate 3 m above came out 1.23× the exact integral read at
+// the cone's level, 1.01× one level finer), over both finer texels of the crossed one in the sub-ray's own column.
 // Surfaces that are not aligned with the axes (a room turned 30°, a sphere) are why the crossing is tested this way.
 // Such a surface lies at another depth in each column of texels, so a depth read once per step jumped between steps
 // and a sub-ray could step over it. Its staircase of voxels also covers complementary parts of a column (two
@@ -117,7 +117,8 @@ ConeResult trace_cone_crossing(vec3 o, vec3 d, float tan_half) {
         // Per axis a, the texels mid − 1 … mid + 1 along a (mid holds the sample) that some sub-ray's path reaches,
         // and where along a their surfaces lie, read in the columns through the axis's position at the step's start
         // (wa) and end (wb): a tilted surface lies at another depth in each column.
-        float wa[9], wb[9];   // voxel units; −1: no surface (surfaces lie at ≥ 1: the grid has an empty margin voxel)
+        // Voxel units; −1: no surface (surfaces lie at ≥ 1: the grid has an empty margin voxel).
+        float wa[9], wb[9];
         bool any_surface = false;
         for (int a = 0; a < 3; ++a) {
             float mid = floor(g[a] / texel);
