@@ -34,7 +34,7 @@ class Clusters:
     key: np.ndarray  # (C,) block index × 6 + side (side_of) of each cluster, ascending
     offsets: np.ndarray  # (C, 2) min / max plane offset n·x (m) of its voxels' centres
     box: np.ndarray  # (C, 2, 3) min / max corner of its voxels' centres
-    extent: np.ndarray  # (C, 2, 3) min / max corner of its surfaces (lpv/gather.glsl rectangle_kernel)
+    polygon: np.ndarray  # (C, 8, 4) the octagon its surfaces span (polygons; lpv/gather.glsl polygon_kernel)
     fine: Grid
     lo: np.ndarray  # the surface voxels' centres' bounding box (faces_something)
     hi: np.ndarray
@@ -196,7 +196,7 @@ def make_clusters(cells: np.ndarray, normals: np.ndarray, areas: np.ndarray, fin
     for i in range(3):
         records["position"][:, i] = np.bincount(index, area * pos[use, i], count) / np.maximum(total, 1e-30)
         records["normal"][:, i] = np.bincount(index, area * side_n[use, i], count)
-    n = records["normal"][:, :3]
+    n = records["normal"][:, :3] / np.maximum(total, 1e-30)[:, None]  # the mean side normal: length 1 if planar
     records["normal"][:, :3] = n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-30)
     records["normal"][:, 3] = total
     records["position"][:, 3] = 1.0
@@ -208,12 +208,64 @@ def make_clusters(cells: np.ndarray, normals: np.ndarray, areas: np.ndarray, fin
     box = np.stack([np.full((count, 3), np.inf), np.full((count, 3), -np.inf)], axis=1)
     np.minimum.at(box[:, 0], index, voxel[use])
     np.maximum.at(box[:, 1], index, voxel[use])
-    extent = np.stack([np.full((count, 3), np.inf), np.full((count, 3), -np.inf)], axis=1)
     side_lo, side_hi = (voxel - 0.5 * fine.cell, voxel + 0.5 * fine.cell) if bounds is None else \
         (np.repeat(np.asarray(b, np.float64), 2, axis=0) for b in bounds)
-    np.minimum.at(extent[:, 0], index, side_lo[use])
-    np.maximum.at(extent[:, 1], index, side_hi[use])
-    return Clusters(block, sides.reshape(-1, 2), records, key[first], offsets, box, extent, fine, lo, hi)
+    polygon = polygons(records, n, index, side_lo[use], side_hi[use], fine.cell)
+    return Clusters(block, sides.reshape(-1, 2), records, key[first], offsets, box, polygon, fine, lo, hi)
+
+
+AXIS_PLANE = 0.985  # cos 10°: a cluster whose normal lies this near an axis lies in that axis' plane
+PLANAR = 0.985  # a cluster whose sides' area-weighted mean normal is this long (10° of spread) lies in one plane
+
+
+def polygons(records: np.ndarray, mean_normal: np.ndarray, index: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+             cell: float) -> np.ndarray:
+    """(C, 8, 4) float32 per cluster: the corners, in order, of the octagon in its plane that holds its sides'
+    surfaces (boxes `lo`, `hi` (N, 3) of the sides of cluster `index`) — lpv/gather.glsl's near field. First corner's
+    w: 1 where the cluster is planar, else 0; second corner's w: the octagon's area.
+
+    The plane passes through the cluster's centroid, across its normal — or across the axis it lies within 10° of
+    (AXIS_PLANE), with the other two axes as its frame; else one frame axis lies across the axis the normal leans
+    least along (a vertical wall at any angle: horizontal and vertical). Each side's surfaces span, along a frame
+    axis t, Σ_i min / max(t_i·lo_i, t_i·hi_i) (exact for a planar piece, whose box's other corners project inside
+    its span); the octagon is where the pieces' spans along the frame's axes and its two diagonals hold (an
+    8-DOP): a rectangle where the surfaces fill one; where a wall at an angle cuts a block of floor, its diagonal
+    edge keeps most of the floor's rectangle that lies beyond the wall out (a rectangle there put 4% of the floor's
+    light on the wall's outside in a closed box turned 30°)."""
+    count = len(records)
+    unit = records["normal"][:, :3].astype(np.float64)
+    dominant = np.argmax(np.abs(unit), axis=1)
+    axis_plane = np.abs(unit[np.arange(count), dominant]) >= AXIS_PLANE
+    eye = np.eye(3)
+    t1 = np.cross(unit, eye[np.argmin(np.abs(unit), axis=1)])
+    t1 /= np.maximum(np.linalg.norm(t1, axis=1, keepdims=True), 1e-30)
+    t2 = np.cross(unit, t1)
+    t1 = np.where(axis_plane[:, None], eye[(dominant + 1) % 3], t1)
+    t2 = np.where(axis_plane[:, None], eye[(dominant + 2) % 3], t2)
+    span = np.zeros((count, 4, 2))  # along t1, t2, t1 + t2, t1 − t2: min, max
+    span[..., 0], span[..., 1] = np.inf, -np.inf
+    piece = []
+    for t in (t1, t2):
+        a, b = t[index] * lo, t[index] * hi
+        piece.append((np.minimum(a, b).sum(axis=1), np.maximum(a, b).sum(axis=1)))
+    (u0, u1), (v0, v1) = piece
+    for k, (low, high) in enumerate(((u0, u1), (v0, v1), (u0 + v0, u1 + v1), (u0 - v1, u1 - v0))):
+        np.minimum.at(span[:, k, 0], index, low)
+        np.maximum.at(span[:, k, 1], index, high)
+    (a0, a1), (b0, b1), (s0, s1), (d0, d1) = span.transpose(1, 2, 0)
+    corners = np.stack([np.stack(c, axis=1) for c in (  # (u, v), counter-clockwise from the bottom edge
+        (s0 - b0, b0), (d1 + b0, b0), (a1, a1 - d1), (a1, s1 - a1),
+        (s1 - b1, b1), (d0 + b1, b1), (a0, a0 - d0), (a0, s0 - a0))], axis=1)  # (C, 8, 2)
+    nxt = np.roll(corners, -1, axis=1)
+    area = 0.5 * np.abs((corners[..., 0] * nxt[..., 1] - nxt[..., 0] * corners[..., 1]).sum(axis=1))
+    centroid = records["position"][:, :3].astype(np.float64)
+    base = centroid - sum(np.einsum("ij,ij->i", centroid, t)[:, None] * t for t in (t1, t2))  # the plane's foot
+    out = np.zeros((count, 8, 4), np.float32)
+    out[..., :3] = base[:, None] + corners[..., :1] * t1[:, None] + corners[..., 1:] * t2[:, None]
+    planar = axis_plane | (np.linalg.norm(mean_normal, axis=1) >= PLANAR)
+    out[:, 0, 3] = planar & (area > 1e-6 * cell * cell)
+    out[:, 1, 3] = area
+    return out
 
 
 def box_distance(points: np.ndarray, box: np.ndarray) -> np.ndarray:

@@ -8,10 +8,10 @@ normal, 45° from either surface, the irradiance of that diagonal plane, and the
 through it, seen edge-on: in a closed furnace box (uniform radiosity) such edge voxels received 0.49–0.50 of the exact
 irradiance and corner voxels 0.23–0.24, so every bounce lost a share of the light (3.4% of the box's area at 32³, 18%
 at 8³: 0.70 of the series after 8 bounces at albedo 1). Split by axis and placed on their surfaces, the floor's part
-is a floor beside the wall and sees it through the transfer's near field (lpv/gather.glsl rectangle_kernel, over the
-box the wall's surfaces span): edge receivers now get 0.97–0.99 of it, the whole box 0.99–0.995 per bounce. Godot's
-VoxelGI and Crassin's anisotropic voxels keep light per axis direction for the same reason: one value per voxel
-cannot tell two surfaces that meet in it apart.
+is a floor beside the wall and sees it through the transfer's near field (lpv/gather.glsl polygon_kernel, over
+the octagon the wall's surfaces span): edge receivers now get 0.97–0.99 of it, the whole box 0.99–0.995 per bounce.
+Godot's VoxelGI and Crassin's anisotropic voxels keep light per axis direction for the same reason: one value per
+voxel cannot tell two surfaces that meet in it apart.
 
 The receivers come from three voxelisations of one fine grid, each of the triangles of one dominant axis
 (voxel/voxelize.py axis_only, positions); the geometry volume's blocking and visibility planes

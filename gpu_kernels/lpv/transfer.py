@@ -68,9 +68,7 @@ def build_transfer(ctx, programs, gv, grid: Grid, clusters: Clusters, occlusion:
         set_uniform(prog, "u_box_hi", tuple(float(v) for v in box[1]))
     sources = ctx.buffer(records.tobytes())
     sources.bind_to_storage_buffer(6)
-    boxes = np.zeros((c, 2, 4), np.float32)
-    boxes[..., :3] = clusters.extent
-    boxes = ctx.buffer(boxes.tobytes())
+    boxes = ctx.buffer(np.ascontiguousarray(clusters.polygon, np.float32).tobytes())
     boxes.bind_to_storage_buffer(9)
     (receivers or gv.surfaces).bind_to_storage_buffer(7)
     chunk = max(1, min(vpls_per_dispatch(grid), ROWS_BYTES // (8 * r)))

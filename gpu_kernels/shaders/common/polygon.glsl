@@ -39,23 +39,31 @@ float triangle_projected_solid_angle(vec3 a, vec3 b, vec3 c, vec3 n) {
     return abs(sum) * 0.5;
 }
 
-// The part of quad q0…q3 above a plane (corner heights u), as a quad: where no corner or two adjacent ones lie below
-// (a plane across the rectangle's axis: a wall standing on a floor's rectangle); false for a triangle or pentagon.
-bool clip_quad(inout vec3 q0, inout vec3 q1, inout vec3 q2, inout vec3 q3, vec4 u) {
-    bvec4 below = lessThan(u, vec4(0.0));
-    if (!any(below)) return true;
-    vec3 r0 = q0, r1 = q1, r2 = q2, r3 = q3;
-    if (below == bvec4(true, true, false, false)) { q0 = cut(r0, r3, u.x, u.w); q1 = cut(r1, r2, u.y, u.z); }
-    else if (below == bvec4(false, true, true, false)) { q1 = cut(r1, r0, u.y, u.x); q2 = cut(r2, r3, u.z, u.w); }
-    else if (below == bvec4(false, false, true, true)) { q2 = cut(r2, r1, u.z, u.y); q3 = cut(r3, r0, u.w, u.x); }
-    else if (below == bvec4(true, false, false, true)) { q3 = cut(r3, r2, u.w, u.z); q0 = cut(r0, r1, u.x, u.y); }
-    else return false;
-    return true;
+// One edge a→b of a convex polygon clipped to the side above the plane through the receiver (heights ha, hb): its
+// term of Lambert's formula, and where it leaves (`leave`) or enters (`enter`) that side.
+float clipped_edge(vec3 a, vec3 b, float ha, float hb, vec3 n, inout vec3 enter, inout vec3 leave) {
+    if (ha >= 0.0 && hb >= 0.0) return lambert_edge(a, b, n);
+    if (ha < 0.0 && hb < 0.0) return 0.0;
+    vec3 c = cut(a, b, ha, hb);
+    if (ha >= 0.0) { leave = c; return lambert_edge(a, c, n); }
+    enter = c;
+    return lambert_edge(c, b, n);
 }
 
-// The projected solid angle of a quad lying wholly above the plane of n (clip_quad first), over its four edges,
-// with no arrays: llvmpipe keeps arrays in memory for the whole shader.
-float quad_projected_solid_angle(vec3 q0, vec3 q1, vec3 q2, vec3 q3, vec3 n) {
-    return abs(lambert_edge(q0, q1, n) + lambert_edge(q1, q2, n) + lambert_edge(q2, q3, n)
-               + lambert_edge(q3, q0, n)) * 0.5;
+// The projected solid angle, seen from the receiver (the origin, normal n), of the part of the convex octagon
+// q0…q7 above its plane (edges may have zero length: a rectangle is an octagon too): the clipped polygon streamed
+// edge by edge with its closing edge along the plane, no arrays — llvmpipe keeps arrays in memory for the whole
+// shader.
+float clipped_octagon_projected_solid_angle(vec3 q0, vec3 q1, vec3 q2, vec3 q3, vec3 q4, vec3 q5, vec3 q6, vec3 q7,
+                                            vec3 n) {
+    vec4 u = vec4(dot(q0, n), dot(q1, n), dot(q2, n), dot(q3, n));
+    vec4 w = vec4(dot(q4, n), dot(q5, n), dot(q6, n), dot(q7, n));
+    if (all(lessThan(u, vec4(0.0))) && all(lessThan(w, vec4(0.0)))) return 0.0;
+    vec3 enter = vec3(0.0), leave = vec3(0.0);
+    float sum = clipped_edge(q0, q1, u.x, u.y, n, enter, leave) + clipped_edge(q1, q2, u.y, u.z, n, enter, leave)
+              + clipped_edge(q2, q3, u.z, u.w, n, enter, leave) + clipped_edge(q3, q4, u.w, w.x, n, enter, leave)
+              + clipped_edge(q4, q5, w.x, w.y, n, enter, leave) + clipped_edge(q5, q6, w.y, w.z, n, enter, leave)
+              + clipped_edge(q6, q7, w.z, w.w, n, enter, leave) + clipped_edge(q7, q0, w.w, u.x, n, enter, leave);
+    if (any(lessThan(u, vec4(0.0))) || any(lessThan(w, vec4(0.0)))) sum += lambert_edge(leave, enter, n);
+    return abs(sum) * 0.5;
 }

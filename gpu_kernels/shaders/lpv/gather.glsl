@@ -23,7 +23,7 @@
 // The result is added, per side, to what lpv/absorb.glsl found (zeros: world light is the sky light's VPLs), so the flux
 // lookup (lpv/lighting.glsl, MODE_FLUX) reads it unchanged; the next bounce's VPLs come from it (lpv/cluster.glsl).
 #include "lpv/common.glsl"
-#include "common/polygon.glsl"  // clip_quad, quad_projected_solid_angle
+#include "common/polygon.glsl"  // clipped_octagon_projected_solid_angle
 
 layout(local_size_x = 64) in;
 #include "common/structs.glsl"
@@ -52,8 +52,9 @@ layout(std430, binding = 10) readonly buffer Receivers { vec4 receivers[]; };
 uniform bool u_update;
 uniform vec3 u_box_lo;
 uniform vec3 u_box_hi;
-// Per source: the min / max corner of its surfaces (lpv/clusters.Clusters.extent), w unused.
-layout(std430, binding = 9) readonly buffer SourceBoxes { vec4 source_boxes[]; };
+// Per source: the octagon its surfaces span in its plane (lpv/clusters.Clusters.polygon), eight corners in order;
+// the first's w is 1 where the cluster is planar, the second's its area.
+layout(std430, binding = 9) readonly buffer SourcePolygons { vec4 source_polygons[]; };
 
 bool crosses_box(vec3 a, vec3 b) {  // the segment a → b meets the box (slab test)
     vec3 d = b - a;
@@ -78,9 +79,8 @@ vec3 step01(vec3 d) {
 }
 const float OWN_PLANE = 0.1;  // MODE_TRANSFER: a receiver this near a source's plane (in fine voxels) lies in it
 const float NEAR_FIELD = 9.0;  // (distance / disc radius)² below which a VPL is split in four
-const float RECTANGLE_FIELD = 36.0;  // MODE_TRANSFER: within 6 disc radii, an axis-plane cluster as its rectangle
+const float POLYGON_FIELD = 36.0;  // MODE_TRANSFER: within 6 disc radii, a planar cluster as its octagon
 const float LAYER_END = 0.05;  // lpv/crossings.END_SLACK: a layer where its surfaces lie
-const float AXIS_PLANE = 0.985;  // a source whose normal is within 10° of an axis lies in that axis' plane
 
 // Which of the three axis planes' crossings at parameters tc lie in the box cell c's surfaces span, given as
 // lpv/crossings.box_code (0: the whole cell); c, o, dir in cells. An axis plane covers its cell only there.
@@ -194,29 +194,22 @@ float transmittance(vec3 from, vec3 n_from, vec3 dir, float dist, vec3 n_to) {
 }
 
 #if defined(MODE_TRANSFER)
-// Near a cluster that lies in an axis plane (a wall's, a floor's): the exact irradiance per watt of a Lambertian
-// rectangle of uniform radiance Φ/(π·A) spanning its voxels in that plane — Lambert's formula over its edges
-// (common/polygon.glsl clip_quad, quad_projected_solid_angle), each side of the receiver seeing the part above its
-// plane. A receiver beside a wall's edge gets half its irradiance from the floor right next to it; the quarter
-// discs below, 1–2 cells out, gave edges 0.7–0.9 of it in a closed box. False where a side sees a triangle or a
-// pentagon of it (the quarter discs then): clipping those needs arrays, which llvmpipe keeps in memory for the
-// whole shader (2.5× slower).
-bool rectangle_kernel(int j, Vpl v, vec3 p, vec3 nv, float h, out vec2 k) {
-    vec3 a = abs(v.normal.xyz);
-    vec3 ea = a.x >= a.y ? (a.x >= a.z ? vec3(1, 0, 0) : vec3(0, 0, 1)) : (a.y >= a.z ? vec3(0, 1, 0) : vec3(0, 0, 1));
-    if (dot(a, ea) < AXIS_PLANE * length(v.normal.xyz)) return false;
-    vec3 eb = ea.zxy, ec = ea.yzx;  // the plane's two axes
-    vec3 lo = source_boxes[2 * j].xyz - p, hi = source_boxes[2 * j + 1].xyz - p;  // its surfaces' extent
-    vec3 base = ea * (v.position.xyz - p);  // corners relative to the receiver, in order around the rectangle
-    vec3 q0 = base + eb * lo + ec * lo, q1 = base + eb * hi + ec * lo;
-    vec3 q2 = base + eb * hi + ec * hi, q3 = base + eb * lo + ec * hi;
-    vec4 up = vec4(dot(q0, nv), dot(q1, nv), dot(q2, nv), dot(q3, nv));
-    vec3 f0 = q0, f1 = q1, f2 = q2, f3 = q3;
-    bool front = any(greaterThan(up, vec4(0.0))), back = any(lessThan(up, vec4(0.0)));
-    if ((front && !clip_quad(f0, f1, f2, f3, up)) || (back && !clip_quad(q0, q1, q2, q3, -up))) return false;
-    float area = dot(hi - lo, eb) * dot(hi - lo, ec);
-    k = vec2(front ? quad_projected_solid_angle(f0, f1, f2, f3, nv) : 0.0,
-             back ? quad_projected_solid_angle(q0, q1, q2, q3, -nv) : 0.0) / (PI * area);
+// Near a cluster that lies in a plane (a wall's, a floor's, at any angle): the exact irradiance per watt of a
+// Lambertian octagon of uniform radiance Φ/(π·A) spanning its surfaces in that plane (lpv/clusters.polygons: a
+// rectangle where they fill one, a block of floor cut off by a wall at an angle otherwise) — Lambert's formula over
+// the edges of the part above each side of the receiver's plane (common/polygon.glsl). A receiver beside a wall's
+// edge gets half its irradiance from the floor right next to it; the quarter discs below, 1–2 cells out, gave edges
+// 0.7–0.9 of it in a closed box. False for a cluster whose surfaces bend (w = 0).
+bool polygon_kernel(int j, vec3 p, vec3 nv, out vec2 k) {
+    vec4 first = source_polygons[8 * j];
+    if (first.w == 0.0) return false;
+    vec3 q0 = first.xyz - p, q1 = source_polygons[8 * j + 1].xyz - p, q2 = source_polygons[8 * j + 2].xyz - p;
+    vec3 q3 = source_polygons[8 * j + 3].xyz - p, q4 = source_polygons[8 * j + 4].xyz - p;
+    vec3 q5 = source_polygons[8 * j + 5].xyz - p, q6 = source_polygons[8 * j + 6].xyz - p;
+    vec3 q7 = source_polygons[8 * j + 7].xyz - p;
+    k = vec2(clipped_octagon_projected_solid_angle(q0, q1, q2, q3, q4, q5, q6, q7, nv),
+             clipped_octagon_projected_solid_angle(q0, q1, q2, q3, q4, q5, q6, q7, -nv))
+      / (PI * source_polygons[8 * j + 1].w);
     return true;
 }
 #endif
@@ -251,7 +244,7 @@ vec2 vpl_kernel(int j, Vpl v, vec3 p, vec3 nv, float h) {
     if (t <= 0.0) return vec2(0.0);
 #if defined(MODE_TRANSFER)
     vec2 exact;
-    if (d2 <= RECTANGLE_FIELD * source_area / PI && rectangle_kernel(j, v, p, nv, h, exact)) return exact * t;
+    if (d2 <= POLYGON_FIELD * source_area / PI && polygon_kernel(j, p, nv, exact)) return exact * t;
 #endif
     if (d2 > NEAR_FIELD * source_area / PI) {
         float e = height / dist * abs(receive) * t / (PI * d2 + source_area);
