@@ -39,31 +39,40 @@ float triangle_projected_solid_angle(vec3 a, vec3 b, vec3 c, vec3 n) {
     return abs(sum) * 0.5;
 }
 
-// One edge a→b of a convex polygon clipped to the side above the plane through the receiver (heights ha, hb): its
-// term of Lambert's formula, and where it leaves (`leave`) or enters (`enter`) that side.
-float clipped_edge(vec3 a, vec3 b, float ha, float hb, vec3 n, inout vec3 enter, inout vec3 leave) {
-    if (ha >= 0.0 && hb >= 0.0) return lambert_edge(a, b, n);
-    if (ha < 0.0 && hb < 0.0) return 0.0;
+// One edge a→b of a convex polygon split by the plane through the receiver (heights ha, hb): its terms of Lambert's
+// formula above the plane (x) and below it (y), and where it leaves (`leave`) or enters (`enter`) the side above.
+// Edges of length 0 (an octagon that is a rectangle) add nothing.
+vec2 split_edge(vec3 a, vec3 b, float ha, float hb, vec3 n, inout vec3 enter, inout vec3 leave) {
+    if (a == b) return vec2(0.0);
+    if ((ha >= 0.0) == (hb >= 0.0)) {
+        float whole = lambert_edge(a, b, n);
+        return ha >= 0.0 ? vec2(whole, 0.0) : vec2(0.0, whole);
+    }
     vec3 c = cut(a, b, ha, hb);
-    if (ha >= 0.0) { leave = c; return lambert_edge(a, c, n); }
+    if (ha >= 0.0) {
+        leave = c;
+        return vec2(lambert_edge(a, c, n), lambert_edge(c, b, n));
+    }
     enter = c;
-    return lambert_edge(c, b, n);
+    return vec2(lambert_edge(c, b, n), lambert_edge(a, c, n));
 }
 
-// The projected solid angle, seen from the receiver (the origin, normal n), of the part of the convex octagon
-// q0…q7 above its plane (edges may have zero length: a rectangle is an octagon too): the clipped polygon streamed
-// edge by edge with its closing edge along the plane, no arrays — llvmpipe keeps arrays in memory for the whole
-// shader.
-float clipped_octagon_projected_solid_angle(vec3 q0, vec3 q1, vec3 q2, vec3 q3, vec3 q4, vec3 q5, vec3 q6, vec3 q7,
-                                            vec3 n) {
+// The projected solid angles, seen from the receiver (the origin) with normal n (x) and with −n (y), of the parts of
+// the convex octagon q0…q7 above and below its plane (edges may have length 0: a rectangle is an octagon too). Each
+// part is its own edges' pieces closed along the plane, leave → enter above and enter → leave below; Lambert's terms
+// for −n are those for n negated, so each edge is walked once for both. No arrays: llvmpipe keeps arrays in memory
+// for the whole shader.
+vec2 split_octagon_projected_solid_angles(vec3 q0, vec3 q1, vec3 q2, vec3 q3, vec3 q4, vec3 q5, vec3 q6,
+                                          vec3 q7, vec3 n) {
     vec4 u = vec4(dot(q0, n), dot(q1, n), dot(q2, n), dot(q3, n));
     vec4 w = vec4(dot(q4, n), dot(q5, n), dot(q6, n), dot(q7, n));
-    if (all(lessThan(u, vec4(0.0))) && all(lessThan(w, vec4(0.0)))) return 0.0;
     vec3 enter = vec3(0.0), leave = vec3(0.0);
-    float sum = clipped_edge(q0, q1, u.x, u.y, n, enter, leave) + clipped_edge(q1, q2, u.y, u.z, n, enter, leave)
-              + clipped_edge(q2, q3, u.z, u.w, n, enter, leave) + clipped_edge(q3, q4, u.w, w.x, n, enter, leave)
-              + clipped_edge(q4, q5, w.x, w.y, n, enter, leave) + clipped_edge(q5, q6, w.y, w.z, n, enter, leave)
-              + clipped_edge(q6, q7, w.z, w.w, n, enter, leave) + clipped_edge(q7, q0, w.w, u.x, n, enter, leave);
-    if (any(lessThan(u, vec4(0.0))) || any(lessThan(w, vec4(0.0)))) sum += lambert_edge(leave, enter, n);
-    return abs(sum) * 0.5;
+    vec2 sum = split_edge(q0, q1, u.x, u.y, n, enter, leave) + split_edge(q1, q2, u.y, u.z, n, enter, leave)
+             + split_edge(q2, q3, u.z, u.w, n, enter, leave) + split_edge(q3, q4, u.w, w.x, n, enter, leave)
+             + split_edge(q4, q5, w.x, w.y, n, enter, leave) + split_edge(q5, q6, w.y, w.z, n, enter, leave)
+             + split_edge(q6, q7, w.z, w.w, n, enter, leave) + split_edge(q7, q0, w.w, u.x, n, enter, leave);
+    bool above = any(greaterThanEqual(u, vec4(0.0))) || any(greaterThanEqual(w, vec4(0.0)));
+    bool below = any(lessThan(u, vec4(0.0))) || any(lessThan(w, vec4(0.0)));
+    float closing = above && below ? lambert_edge(leave, enter, n) : 0.0;
+    return 0.5 * abs(sum + vec2(closing, -closing));
 }

@@ -23,7 +23,7 @@
 // The result is added, per side, to what lpv/absorb.glsl found (zeros: world light is the sky light's VPLs), so the flux
 // lookup (lpv/lighting.glsl, MODE_FLUX) reads it unchanged; the next bounce's VPLs come from it (lpv/cluster.glsl).
 #include "lpv/common.glsl"
-#include "common/polygon.glsl"  // clipped_octagon_projected_solid_angle
+#include "common/polygon.glsl"  // split_octagon_projected_solid_angles
 
 layout(local_size_x = 64) in;
 #include "common/structs.glsl"
@@ -207,8 +207,7 @@ bool polygon_kernel(int j, vec3 p, vec3 nv, out vec2 k) {
     vec3 q3 = source_polygons[8 * j + 3].xyz - p, q4 = source_polygons[8 * j + 4].xyz - p;
     vec3 q5 = source_polygons[8 * j + 5].xyz - p, q6 = source_polygons[8 * j + 6].xyz - p;
     vec3 q7 = source_polygons[8 * j + 7].xyz - p;
-    k = vec2(clipped_octagon_projected_solid_angle(q0, q1, q2, q3, q4, q5, q6, q7, nv),
-             clipped_octagon_projected_solid_angle(q0, q1, q2, q3, q4, q5, q6, q7, -nv))
+    k = split_octagon_projected_solid_angles(q0, q1, q2, q3, q4, q5, q6, q7, nv)
       / (PI * source_polygons[8 * j + 1].w);
     return true;
 }
