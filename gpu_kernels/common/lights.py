@@ -52,11 +52,7 @@ class ShadowSettings:
     spot_resolution: int = 1024
     cube_resolution: int = 512  # per face, point lights
     sample_cube_resolution: int = 256  # per face, area/emissive sample points
-    # n×n shadow sample points on square/rectangle lights (n² ring points on disks). Each stands for a patch of the
-    # light (direct/eval.glsl patch_visibility); at 2×2 a patch is a quarter of the light and its backprojected
-    # penumbra drifts from Cycles' in broad blobs. 3×3 renders 2.25× the shadow cubes of 2×2 for a smaller Diffuse
-    # Direct error wherever area lights cast shadows (measured: benchmarks/results/llvmpipe/incremental.md).
-    area_samples: int = 3
+    area_samples: int = 2  # n×n shadow sample points on square/rectangle lights (n² ring points on disks)
     # Shadow cubes for all emissive triangles together: they form ≤ budget/2 clusters (common/emitters.py), each
     # shadowed from 1–4 sample points on each of its two sides.
     emissive_sample_budget: int = 64
