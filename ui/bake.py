@@ -23,7 +23,7 @@ change the vertex count cannot take per-vertex values on their original data: th
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -35,6 +35,13 @@ ATTRIBUTE = "BounceGI"
 INSET_CELLS = {"lpv": 0.3, "vct": 1.0}
 INSET_LIMIT = 0.45  # ... but at most this fraction of the way to the centre
 EXTRACT_SIZE = (64, 64)  # the bake renders no image; extraction wants a size
+# The LPV's first bounce is its RSM's texels binned into the cached transport's clusters (lpv/clusters.bin_flux): a
+# cluster's flux is right only to within the texels along its edges, and an area light's views get few texels each
+# (lpv/rsm.view_resolution; with 2048 clusters a strip of the Cornell box's floor along a wall got 1.4x the flux per
+# area of the strip next to it). The image averages that out over many clusters; a vertex at a junction reads the
+# clusters right beside it. A bake runs once, so it renders the RSM this many times finer than a render (measured:
+# README).
+BAKE_RSM_SCALE = 2
 
 
 @dataclass
@@ -151,6 +158,13 @@ def write_attribute(mesh, values: np.ndarray) -> None:
     mesh.update()
 
 
+def bake_settings(settings):
+    """The RenderSettings a bake runs: the render's, with the LPV's RSM BAKE_RSM_SCALE times as fine."""
+    if settings.method != "lpv":
+        return settings
+    return replace(settings, lpv=replace(settings.lpv, rsm_resolution=BAKE_RSM_SCALE * settings.lpv.rsm_resolution))
+
+
 def bake_objects(context, selected_only: bool) -> list:
     """The mesh objects to bake: visible in the view layer and rendered (and selected, if asked)."""
     objs = context.selected_objects if selected_only else context.view_layer.objects
@@ -174,7 +188,7 @@ def start_bake(context, selected_only: bool) -> PendingBake:
         scene_data = extract_scene(depsgraph, EXTRACT_SIZE, require_camera=False)
     except ExtractError as ex:
         raise PreviewError(one_line(ex)) from None
-    settings, _ = render_settings_of(context.scene.bounce_gi, *EXTRACT_SIZE)
+    settings = bake_settings(render_settings_of(context.scene.bounce_gi, *EXTRACT_SIZE)[0])
     inset = INSET_CELLS.get(settings.method, 0.0) * method_cell(scene_data, settings)
     positions = np.concatenate([evaluation_points(t, inset) for t in targets]).astype(np.float32)
     normals = np.concatenate([t.normals for t in targets]).astype(np.float32)

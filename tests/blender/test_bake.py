@@ -79,16 +79,18 @@ def run_case(tmp_path, body: str, timeout: float = 600) -> str:
 
 
 def test_bake_against_cycles_vertex_bake_and_mesh_data_untouched(tmp_path):
-    # Per-vertex rel-L1 against Cycles' vertex bake, LPV at its Medium settings (32^3, 8 bounces), measured with
-    # INSET_CELLS["lpv"] = 0.3 (2026-12-05, after the transfer's near field became octagons in each cluster's plane;
-    # 2026-12-03: 0.235 / 0.156): 0.232 on the Cornell box, which misses the issue's target of 0.20 (its back corners
-    # under the ceiling are 1.5x too bright, the boxes' feet half as bright as Cycles': README), and 0.134 on
-    # spot_room. Bound: the measurement + 2 x the noise floor of this test's 1024-spp two-seed reference
-    # (half the seeds' rel-L1, ~0.02: the reference's own error, as tests/accuracy/test_examples_vs_cycles.py
-    # argues) + 0.001 for float rounding, so a regression beyond the reference's noise fails.
-    measured = {"cornell": 0.232, "spot_room": 0.134}
+    # Per-vertex rel-L1 against Cycles' vertex bake, LPV at its Medium settings (32^3, 8 bounces) with the bake's
+    # RSM twice as fine as a render's (ui/bake.BAKE_RSM_SCALE), INSET_CELLS["lpv"] = 0.3, measured 2026-12-05: 0.191 on
+    # the Cornell box, 0.133 on spot_room (with the render's RSM: 0.232 and 0.134; the Cornell box missed the issue's
+    # target of 0.20, its room corners 1.1-1.9x too bright). Bound: the measurement + 2 x the noise floor of this
+    # test's 1024-spp two-seed reference (half the seeds' rel-L1, ~0.02: the reference's own error, as
+    # tests/accuracy/test_examples_vs_cycles.py argues) + 0.001 for float rounding, or the issue's target where the
+    # measurement meets it and the target is lower, so a regression beyond the reference's noise fails and the target,
+    # once met, stays met.
+    measured = {"cornell": 0.191, "spot_room": 0.133}
+    target = 0.20
     run_case(tmp_path, """
-        measured = """ + repr(measured) + """
+        measured, target = """ + repr(measured) + ", " + repr(target) + """
         for name in ("cornell", "spot_room"):
             scenes.build(name)
             scene = bpy.context.scene
@@ -102,7 +104,8 @@ def test_bake_against_cycles_vertex_bake_and_mesh_data_untouched(tmp_path):
             err = rel_l1(ours, ref)
             print(f"{name}: per-vertex rel-L1 {err:.3f} (reference noise {floor:.3f}, Cycles 1024 spp x 2 "
                   f"{cycles_s:.2f} s), vertices {sum(len(v) for v in ours.values())}")
-            assert err <= measured[name] + 2 * floor + 0.001, (name, err, floor)
+            bound = measured[name] + 2 * floor + 0.001
+            assert err <= (min(bound, target) if measured[name] <= target else bound), (name, err, floor)
             after = mesh_state(meshes)
             same_state(before, after)             # nothing but the BounceGI attribute changed ...
             assert all(bake.ATTRIBUTE in o.data.color_attributes for o in meshes)
