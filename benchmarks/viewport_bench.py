@@ -126,6 +126,32 @@ def redraw_costs(drawing, positions, world, sizes) -> dict:
     return out
 
 
+def mode_switch_costs(drawing, world, size) -> dict:
+    """Display mode → seconds of its first redraw at `size` (up to a 1-pixel read-back), after the viewport's timer
+    has run draw.compile_next_shader until nothing is left, as it does after a result is shown: the main thread's
+    stall when the user first switches to that mode."""
+    import bpy
+    import gpu
+
+    from bounce_gi.addon.extract.camera import read_camera
+    from bounce_gi.ui import draw
+
+    while draw.compile_next_shader(drawing):
+        pass
+    w, h = size
+    target = gpu.types.GPUOffScreen(w, h, format="RGBA16F")
+    view = draw.camera_view(read_camera(bpy.context.scene), w, h)
+    out = {}
+    for mode in (m for m in draw.MODES if m != "COMBINED"):
+        start = time.perf_counter()
+        with target.bind():
+            draw.draw_view3d(drawing, view, world, mode)
+            gpu.state.active_framebuffer_get().read_color(0, 0, 1, 1, 4, 0, "FLOAT")
+        out[mode] = time.perf_counter() - start
+    target.free()
+    return out
+
+
 def open_scene(name: str, method: str):
     """Build example scene `name`, open it as a .blend (as a user would), set the method; bpy's gpu ready."""
     import bpy
@@ -209,10 +235,12 @@ def bench_scene(name: str, method: str, sizes, redraw_only=False) -> dict:
     else:
         rows = edit_latencies(feed, scene)
     redraw = redraw_costs(feed.session.drawing, _positions(), feed.world_color, sizes)
+    switch = mode_switch_costs(feed.session.drawing, feed.world_color, sizes[0])
     f12 = None if redraw_only else f12_times(scene)
     stats = feed.session.stats
     feed.close()
-    return {"rows": rows, "redraw": redraw, "f12": f12, "texels": stats.texels, "triangles": stats.triangles}
+    return {"rows": rows, "redraw": redraw, "switch": switch, "f12": f12, "texels": stats.texels,
+            "triangles": stats.triangles}
 
 
 def _positions():
@@ -251,6 +279,8 @@ def print_scene(name: str, method: str, r: dict) -> None:
     for (w, h), (ours, flat, diff, load) in r["redraw"].items():
         print(f"redraw {w}x{h}: ours {ours * 1000:.2f} ms, builtin flat shader {flat * 1000:.2f} ms, "
               f"difference {diff * 1000:.2f} ms; {load_note(load)}")
+    print("first redraw after a switch of display mode: " +
+          ", ".join(f"{mode.lower()} {t * 1000:.1f} ms" for mode, t in r["switch"].items()))
     if r["f12"]:
         print(f"F12 160x120: {r['f12']['cold']:.2f} s with every pass run, {r['f12']['again']:.2f} s again")
 

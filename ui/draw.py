@@ -118,19 +118,43 @@ def shaders_to_compile(drawing) -> list:
     return [(*variant, mode) for variant in variants for mode in MODES if (*variant, mode) not in _shaders]
 
 
+_warm = {}  # (share, flat, mode) → True once drawn into the warm-up buffer; "target": that buffer
+
+
 def compile_next_shader(drawing) -> bool:
-    """Compile one variant `drawing` may need (shaders_to_compile); whether any is left. Called from a timer after
-    a result is shown, one a tick, so that switching the display mode later draws at once: compiling a variant
-    when first drawn stalled the first switch to Direct or Indirect by ~0.1 s on llvmpipe."""
+    """Compile, then draw once into a 1×1 buffer like the 3D view's, one variant `drawing` may need in some display
+    mode (shaders_to_compile); whether any is left. Called from a timer after a result is shown, one a tick, so that
+    switching the display mode later draws at once: on llvmpipe a variant compiled at its first draw stalled the
+    first switch to Direct or Indirect, and one compiled but never drawn still did, the driver building its code
+    for the framebuffer at the first draw (measured: benchmarks/results/viewport_llvmpipe.md)."""
     missing = shaders_to_compile(drawing)
     if missing:
         surface_shader(*missing[0])
-    return len(missing) > 1
+        return True
+    parts = {part[0]: part for part in getattr(drawing, "parts", ())}
+    cold = [(variant, mode) for variant in parts for mode in MODES if (variant, mode) not in _warm]
+    if cold:
+        variant, mode = cold[0]
+        if "target" not in _warm:
+            _warm["target"] = gpu.types.GPUOffScreen(1, 1, format="RGBA16F")  # as the 3D view's colour buffer
+        with _warm["target"].bind():
+            gpu.state.depth_test_set("LESS_EQUAL")
+            gpu.state.depth_mask_set(True)
+            draw_part(parts[variant], mode, push_constants(WARM_VIEW, 0.0, drawing.page_heights))
+            gpu.state.depth_test_set("NONE")
+            gpu.state.depth_mask_set(False)
+        _warm[variant, mode] = True
+    return len(cold) > 1
 
 
 def release_shader() -> None:
-    """Forget the compiled shaders (on unregister: a re-enabled extension compiles its own)."""
+    """Forget the compiled shaders and the warm-up buffer (on unregister: a re-enabled extension compiles its
+    own)."""
     _shaders.clear()
+    target = _warm.pop("target", None)
+    if target is not None:
+        target.free()
+    _warm.clear()
 
 
 def filtered(texture):
@@ -175,6 +199,8 @@ class View:
     forward: tuple
     ortho: bool = False
 
+
+WARM_VIEW = View(np.eye(4), (0.0, 0.0, 1.0), (0.0, 0.0, -1.0))  # any view: compile_next_shader's warm-up draw
 
 def vertex_buffer(arrays: dict):
     """name → (N, C) float32 arrays as one GPUVertBuf (the shaders find their inputs by name)."""
@@ -222,22 +248,13 @@ class SurfaceDrawing:
         pass with back faces culled, then one with front faces culled: each triangle is drawn once)."""
         if not self.parts:
             return
-        constants = {"u_view_projection": Matrix(np.asarray(view.view_projection, float).tolist()),
-                     "u_eye": (*view.eye, 1.0 if view.ortho else 0.0),
-                     "u_forward": (*view.forward, float(depth_pull)),
-                     "u_pages": self.page_heights}
+        constants = push_constants(view, depth_pull, self.page_heights)
         gpu.state.depth_test_set("LESS_EQUAL")
         gpu.state.depth_mask_set(True)
         for culled in ("BACK", "FRONT") if self.triangles <= FRONT_FIRST_TRIANGLES else ("NONE",):
             gpu.state.face_culling_set(culled)
-            for variant, batch, textures in self.parts:
-                shader = surface_shader(*variant, mode)
-                shader.bind()
-                for name, value in constants.items():
-                    shader.uniform_float(name, value)
-                for name, texture in textures.items():
-                    shader.uniform_sampler(name, texture)
-                batch.draw(shader)
+            for part in self.parts:
+                draw_part(part, mode, constants)
         gpu.state.face_culling_set("NONE")
         gpu.state.depth_test_set("NONE")
         gpu.state.depth_mask_set(False)
@@ -245,6 +262,25 @@ class SurfaceDrawing:
     def free(self) -> None:
         """Drop the textures and the batches (Blender frees GPU objects when their Python objects go)."""
         self.parts = []
+
+
+def push_constants(view: View, depth_pull: float, page_heights) -> dict:
+    """The surface shader's push constants for `view` (surface.glsl)."""
+    return {"u_view_projection": Matrix(np.asarray(view.view_projection, float).tolist()),
+            "u_eye": (*view.eye, 1.0 if view.ortho else 0.0), "u_forward": (*view.forward, float(depth_pull)),
+            "u_pages": page_heights}
+
+
+def draw_part(part, mode: str, constants: dict) -> None:
+    """Draw one part ((variant, batch, textures) of SurfaceDrawing.parts) in display mode `mode`."""
+    variant, batch, textures = part
+    shader = surface_shader(*variant, mode)
+    shader.bind()
+    for name, value in constants.items():
+        shader.uniform_float(name, value)
+    for name, texture in textures.items():
+        shader.uniform_sampler(name, texture)
+    batch.draw(shader)
 
 
 def draw_frame(drawing: SurfaceDrawing | None, view: View, background, mode="COMBINED") -> None:
