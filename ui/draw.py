@@ -131,20 +131,31 @@ def compile_next_shader(drawing) -> bool:
     if missing:
         surface_shader(*missing[0])
         return True
-    parts = {part[0]: part for part in getattr(drawing, "parts", ())}
-    cold = [(variant, mode) for variant in parts for mode in MODES if (variant, mode) not in _warm]
+    cold = cold_variants(drawing)
     if cold:
-        variant, mode = cold[0]
-        if "target" not in _warm:
-            _warm["target"] = gpu.types.GPUOffScreen(1, 1, format="RGBA16F")  # as the 3D view's colour buffer
-        with _warm["target"].bind():
-            gpu.state.depth_test_set("LESS_EQUAL")
-            gpu.state.depth_mask_set(True)
-            draw_part(parts[variant], mode, push_constants(WARM_VIEW, 0.0, drawing.page_heights))
-            gpu.state.depth_test_set("NONE")
-            gpu.state.depth_mask_set(False)
-        _warm[variant, mode] = True
+        warm_variant(drawing, *cold[0])
     return len(cold) > 1
+
+
+def cold_variants(drawing, modes=MODES) -> list:
+    """The (variant, mode) pairs of `drawing`'s parts in `modes` not yet drawn into the warm-up buffer."""
+    variants = dict.fromkeys(part[0] for part in getattr(drawing, "parts", ()))
+    return [(variant, mode) for variant in variants for mode in modes if (variant, mode) not in _warm]
+
+
+def warm_variant(drawing, variant, mode) -> None:
+    """Draw `drawing`'s part of `variant` once in display mode `mode` into a 1×1 RGBA16F buffer (the 3D view's
+    colour format), so that the driver has built its code for such a framebuffer before a redraw needs it."""
+    if "target" not in _warm:
+        _warm["target"] = gpu.types.GPUOffScreen(1, 1, format="RGBA16F")
+    part = next(p for p in drawing.parts if p[0] == variant)
+    with _warm["target"].bind():
+        gpu.state.depth_test_set("LESS_EQUAL")
+        gpu.state.depth_mask_set(True)
+        draw_part(part, mode, push_constants(WARM_VIEW, 0.0, drawing.page_heights))
+        gpu.state.depth_test_set("NONE")
+        gpu.state.depth_mask_set(False)
+    _warm[variant, mode] = True
 
 
 def release_shader() -> None:
@@ -241,6 +252,8 @@ class SurfaceDrawing:
                 textures[sampler] = shares[sampler, first]
             batch = gpu.types.GPUBatch(type="TRIS", buf=vbo, elem=gpu.types.GPUIndexBuf(type="TRIS", seq=corners))
             self.parts.append(((share, flat), batch, textures))
+        for variant, mode in cold_variants(self, ("COMBINED",)):  # the default display, before its first redraw:
+            warm_variant(self, variant, mode)  # at 1×1 a few ms, at first draw in the view several times that
 
     def draw(self, view: View, mode: str = "COMBINED", depth_pull: float = 0.0) -> None:
         """Draw into the bound framebuffer, depth-tested (LESS_EQUAL) and depth-writing, both sides of every
