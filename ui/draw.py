@@ -149,12 +149,13 @@ def warm_variant(drawing, variant, mode) -> None:
     if "target" not in _warm:
         _warm["target"] = gpu.types.GPUOffScreen(1, 1, format="RGBA16F")
     part = next(p for p in drawing.parts if p[0] == variant)
+    test, mask = gpu.state.depth_test_get(), gpu.state.depth_mask_get()  # the caller's, given back
     with _warm["target"].bind():
         gpu.state.depth_test_set("LESS_EQUAL")
         gpu.state.depth_mask_set(True)
         draw_part(part, mode, push_constants(WARM_VIEW, 0.0, drawing.page_heights))
-        gpu.state.depth_test_set("NONE")
-        gpu.state.depth_mask_set(False)
+    gpu.state.depth_test_set(test)
+    gpu.state.depth_mask_set(mask)
     _warm[variant, mode] = True
 
 
