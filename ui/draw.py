@@ -118,7 +118,8 @@ def shaders_to_compile(drawing) -> list:
     return [(*variant, mode) for variant in variants for mode in MODES if (*variant, mode) not in _shaders]
 
 
-_warm = {}  # (share, flat, mode) → True once drawn into the warm-up buffer; "target": that buffer
+_warmed = set()  # (share, flat, mode) drawn once into _warm_target
+_warm_target = None  # the 1×1 warm-up buffer, made at the first warm-up draw
 
 
 def compile_next_shader(drawing) -> bool:
@@ -140,33 +141,35 @@ def compile_next_shader(drawing) -> bool:
 def cold_variants(drawing, modes=MODES) -> list:
     """The (variant, mode) pairs of `drawing`'s parts in `modes` not yet drawn into the warm-up buffer."""
     variants = dict.fromkeys(part[0] for part in getattr(drawing, "parts", ()))
-    return [(variant, mode) for variant in variants for mode in modes if (variant, mode) not in _warm]
+    return [(variant, mode) for variant in variants for mode in modes if (*variant, mode) not in _warmed]
 
 
 def warm_variant(drawing, variant, mode) -> None:
     """Draw `drawing`'s part of `variant` once in display mode `mode` into a 1×1 RGBA16F buffer (the 3D view's
     colour format), so that the driver has built its code for such a framebuffer before a redraw needs it."""
-    if "target" not in _warm:
-        _warm["target"] = gpu.types.GPUOffScreen(1, 1, format="RGBA16F")
+    global _warm_target
+    if _warm_target is None:
+        _warm_target = gpu.types.GPUOffScreen(1, 1, format="RGBA16F")
     part = next(p for p in drawing.parts if p[0] == variant)
     test, mask = gpu.state.depth_test_get(), gpu.state.depth_mask_get()  # the caller's, given back
-    with _warm["target"].bind():
+    with _warm_target.bind():
         gpu.state.depth_test_set("LESS_EQUAL")
         gpu.state.depth_mask_set(True)
         draw_part(part, mode, push_constants(WARM_VIEW, 0.0, drawing.page_heights))
     gpu.state.depth_test_set(test)
     gpu.state.depth_mask_set(mask)
-    _warm[variant, mode] = True
+    _warmed.add((*variant, mode))
 
 
 def release_shader() -> None:
     """Forget the compiled shaders and the warm-up buffer (on unregister: a re-enabled extension compiles its
     own)."""
+    global _warm_target
     _shaders.clear()
-    target = _warm.pop("target", None)
-    if target is not None:
-        target.free()
-    _warm.clear()
+    _warmed.clear()
+    if _warm_target is not None:
+        _warm_target.free()
+        _warm_target = None
 
 
 def filtered(texture):
@@ -213,6 +216,7 @@ class View:
 
 
 WARM_VIEW = View(np.eye(4), (0.0, 0.0, 1.0), (0.0, 0.0, -1.0))  # any view: compile_next_shader's warm-up draw
+
 
 def vertex_buffer(arrays: dict):
     """name → (N, C) float32 arrays as one GPUVertBuf (the shaders find their inputs by name)."""

@@ -68,8 +68,8 @@ def build_transfer(ctx, programs, gv, grid: Grid, clusters: Clusters, occlusion:
         set_uniform(prog, "u_box_hi", tuple(float(v) for v in box[1]))
     sources = ctx.buffer(records.tobytes())
     sources.bind_to_storage_buffer(6)
-    boxes = ctx.buffer(np.ascontiguousarray(clusters.polygon, np.float32).tobytes())
-    boxes.bind_to_storage_buffer(9)
+    polygons = ctx.buffer(np.ascontiguousarray(clusters.polygon, np.float32).tobytes())
+    polygons.bind_to_storage_buffer(9)
     (receivers or gv.surfaces).bind_to_storage_buffer(7)
     chunk = max(1, min(vpls_per_dispatch(grid), ROWS_BYTES // (8 * r)))
     rows = ctx.buffer(reserve=min(chunk, c) * r * 8)
@@ -83,7 +83,7 @@ def build_transfer(ctx, programs, gv, grid: Grid, clusters: Clusters, occlusion:
         block = np.frombuffer(rows.read(size=count * r * 8), np.float32).reshape(count, r, 2)
         out[0, first:first + count] = block[..., 0]
         out[1, first:first + count] = block[..., 1]
-    for buffer in (rows, sources, boxes, receivers):
+    for buffer in (rows, sources, polygons, receivers):
         if buffer is not None:
             buffer.release()
     return out

@@ -83,7 +83,7 @@ while True:
     ticks += 1
     if not more or ticks > 100:
         break
-warmed = all((variant, mode) in draw._warm for variant, _, _ in drawing.parts for mode in draw.MODES)
+warmed = not draw.cold_variants(drawing)  # every variant of every mode drawn once
 print("RESULT", len(first), ticks, len(draw.shaders_to_compile(drawing)), max(times), warmed)
 """
 
