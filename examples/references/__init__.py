@@ -1,5 +1,6 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""Committed Cycles references of the example scenes like users' (examples.scenes.USER_SCENES).
+"""Committed Cycles references of the example scenes like users' (examples.scenes.USER_SCENES), and of the typical
+interiors the transport tests compare at full and at one bounce (TRANSPORT).
 
 For each scene, `<name>.npz` holds the two-seed mean of every pass we compare, as float16 (H, W, 3) arrays named
 like Cycles' passes (PASSES), plus `Depth` (H, W, 1; inf where nothing is hit, since Cycles' 1e10 overflows
@@ -36,6 +37,36 @@ FRAMES = {"default_principled": 1, "metals": 1, "textured": 1, "window_room": 1,
 # what its scene was rendered with.
 SAMPLES = 1024
 BOUNCES = 8
+# The typical interiors of the transport tests (tests/accuracy/test_lpv_vs_cycles.py, test_vct_vs_cycles.py), each
+# against full-bounce Cycles and against one bounce: reference name -> (scene, Cycles' bounces), at frame 1.
+TRANSPORT = {"cornell": ("cornell", BOUNCES), "spot_room": ("spot_room", BOUNCES), "courtyard": ("courtyard", BOUNCES),
+             "cornell_1bounce": ("cornell", 1), "spot_room_1bounce": ("spot_room", 1),
+             "courtyard_1bounce": ("courtyard", 1)}
+# Their samples per pixel and seed: 4096 (a few minutes each), since their tests' bounds add 2 × the noise floor.
+TRANSPORT_SAMPLES = 4096
+
+
+def names() -> list:
+    """Every committed reference: the scenes like users' (FRAMES), then the transport tests' (TRANSPORT)."""
+    return list(FRAMES) + list(TRANSPORT)
+
+
+def spec(name: str) -> tuple[str, int, int]:
+    """(scene, frame, Cycles' bounces) of the committed reference `name`."""
+    if name in FRAMES:
+        return name, FRAMES[name], BOUNCES
+    scene, bounces = TRANSPORT[name]
+    return scene, 1, bounces
+
+
+def default_samples(name: str) -> int:
+    """The samples per pixel and seed reference `name` is rendered with unless told otherwise."""
+    return TRANSPORT_SAMPLES if name in TRANSPORT else SAMPLES
+
+
+def transport_name(scene: str, bounces: int) -> str:
+    """The TRANSPORT reference of `scene` against Cycles with `bounces` bounces."""
+    return scene if bounces == BOUNCES else f"{scene}_{bounces}bounce"
 
 
 @dataclass
@@ -49,20 +80,29 @@ class CommittedReference:
         """(H, W) pixels where Cycles hit geometry."""
         return self.passes["Depth"][..., 0] < 1e9
 
-    def noise_floor(self, name: str) -> float:
-        """Half the rel-L1 between the two seeds over the pixels Cycles hit (NaN where the pass is 0 there)."""
+    def noise_floor(self, name: str, mask=None) -> float:
+        """Half the rel-L1 between the two seeds over the pixels Cycles hit (NaN where the pass is 0 there). `mask`
+        is ignored (the seeds are not kept): with it this stands in for addon/reference/cycles.Reference."""
         return float(self.meta["noise_floor"].get(name, float("nan")))
+
+    @property
+    def seconds(self) -> float:
+        return float(self.meta.get("seconds", float("nan")))
+
+    @property
+    def cached(self) -> bool:
+        return True
 
 
 def build(name: str) -> None:
-    """Build scene `name` (examples.scenes.build) at its reference frame: what the reference was rendered from and
-    what the test renders."""
+    """Build the scene of reference `name` (examples.scenes.build) at its frame: what the reference was rendered from
+    and what the test renders."""
     import bpy
 
     from .. import scenes
 
-    scenes.build(name)
-    frame = FRAMES[name]
+    scene, frame, _ = spec(name)
+    scenes.build(scene)
     if frame != bpy.context.scene.frame_current:
         bpy.context.scene.frame_set(frame)
         bpy.context.view_layer.update()

@@ -3,7 +3,7 @@
 
     python examples/references/make_references.py [NAME ...] [--samples N] [--force] [--out DIR]
 
-For each scene of examples.references.FRAMES (or the named ones): build it (examples.scenes.build, at its
+For each reference of examples.references.names() (or the named ones): build its scene (examples.scenes.build, at its
 reference frame), render the project's two-seed Cycles reference with addon/reference/cycles.py (CPU, adaptive
 sampling off, denoising off, clamps 0, light threshold 0, pixel filter 0.01 px, 8 bounces of every kind, seeds 1
 and 2) at 160x120, and write <name>.npz (the two-seed mean of PASSES and Depth, float16) and <name>.json (settings,
@@ -18,6 +18,10 @@ the fastest). At 2048 the whole set would have taken about 2.4 hours, so it is r
 the timing run, kept at 2048); each JSON records its samples and each pass's noise floor, which says what the
 lower count costs (at 1024 spp Combined's floor is 0.002-0.046, Diffuse Indirect's 0.017-0.067). Re-run with
 --samples 2048 --force on a faster machine to lower the floors by about 1/sqrt(2).
+
+The transport tests' references (examples.references.TRANSPORT: cornell, spot_room, courtyard at 8 bounces and at 1)
+are rendered with 4096 samples (references.TRANSPORT_SAMPLES; 1.7-3 min each here, 2026-12-05): their tests hold
+bounds of measured + 2 x the noise floor, so a lower floor is a tighter test.
 
 Needs bpy; run with the repository root (or its parent, for `bounce_gi`) importable, like the tests.
 """
@@ -67,9 +71,10 @@ def color_unstable(seeds: list, hit: np.ndarray) -> float:
 
 
 def make(name: str, samples: int, out: str, force: bool) -> None:
+    scene, frame, bounces = references.spec(name)
     references.build(name)
     fp = references.fingerprint()
-    settings = ReferenceSettings(*RESOLUTION, samples=samples, bounces=references.BOUNCES)
+    settings = ReferenceSettings(*RESOLUTION, samples=samples, bounces=bounces)
     _, meta_path = references.paths(name, out)
     if not force and os.path.exists(meta_path):
         old = references.load(name, out).meta
@@ -86,7 +91,7 @@ def make(name: str, samples: int, out: str, force: bool) -> None:
     passes = {p: ref.passes[p][..., :3] for p in references.PASSES}
     passes["Depth"] = ref.passes["Depth"][..., :1]
     meta = {
-        "scene": name, "frame": references.FRAMES[name], "fingerprint": fp,
+        "scene": scene, "frame": frame, "fingerprint": fp,
         "description": scenes.USER_SCENES.get(name, ""),
         "samples": samples, "seeds": list(settings.seeds), "bounces": settings.bounces,
         "resolution": list(RESOLUTION),
@@ -110,17 +115,18 @@ def make(name: str, samples: int, out: str, force: bool) -> None:
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("names", nargs="*", metavar="NAME")
-    parser.add_argument("--samples", type=int, default=references.SAMPLES)
+    parser.add_argument("--samples", type=int, default=None,
+                        help="per pixel and seed (default: references.default_samples, 1024 or 4096)")
     parser.add_argument("--force", action="store_true", help="render even where the files are up to date")
     parser.add_argument("--out", default=references.DIR)
     args = parser.parse_args(argv)
-    names = args.names or list(references.FRAMES)
-    unknown = [n for n in names if n not in references.FRAMES]
+    names = args.names or references.names()
+    unknown = [n for n in names if n not in references.names()]
     if unknown:
-        parser.error(f"no reference for {' '.join(unknown)}; known: {' '.join(references.FRAMES)}")
+        parser.error(f"no reference for {' '.join(unknown)}; known: {' '.join(references.names())}")
     os.makedirs(args.out, exist_ok=True)
     for name in names:
-        make(name, args.samples, args.out, args.force)
+        make(name, args.samples or references.default_samples(name), args.out, args.force)
     return 0
 
 

@@ -5,8 +5,11 @@ Run in a subprocess by the `compare_examples` fixture (tests/conftest.py) for te
 stays out of the pytest process:
     python tests/support/compare_examples.py SAMPLES NAME [NAME...] [--method lpv|vct] [--bounces N]
                                              [--lpv KEY=VALUE ...] [--vct KEY=VALUE ...]
-A NAME is an example scene (examples.scenes.SCENES) or a test scene as `module:function` (build below). Besides
-rel-L1 and noise floors, each report holds the ratio Σ ours / Σ Cycles per compared pass.
+A NAME is an example scene (examples.scenes.SCENES) or a test scene as `module:function` (build below). SAMPLES is
+Cycles' samples per pixel and seed of a reference rendered (or found in the cache) now, or `committed`: the scene's
+committed reference against Cycles with --bounces bounces (examples/references TRANSPORT), never rendered here; it
+must belong to the scene as built now (references.stale). Besides rel-L1 and noise floors, each report holds the
+ratio Σ ours / Σ Cycles per compared pass.
 """
 import json
 import os
@@ -18,6 +21,8 @@ from bounce_gi.addon.cli import compare  # noqa: E402
 from bounce_gi.addon.extract import extract_scene  # noqa: E402
 from examples import scenes  # noqa: E402
 
+COMMITTED = "committed"  # SAMPLES: the committed reference instead of a Cycles render
+
 
 def main():
     import bpy
@@ -27,7 +32,7 @@ def main():
     from bounce_gi.addon.cli import parse_method_options, vct_options
 
     parser = argparse.ArgumentParser()
-    parser.add_argument("samples", type=int)
+    parser.add_argument("samples", type=lambda v: v if v == COMMITTED else int(v))
     parser.add_argument("names", nargs="+")
     parser.add_argument("--method", default="none")
     parser.add_argument("--bounces", type=int, default=8, help="Cycles bounces of the reference")
@@ -38,11 +43,14 @@ def main():
     args = parser.parse_args()
     out = {}
     for name in args.names:
-        build(name)
-        scene = extract_scene(bpy.context.evaluated_depsgraph_get())
-        report, result, ref, mask = compare(scene, args.method, args.samples, args.bounces, progress=lambda m: None,
-                                            lpv_options=parse_method_options(args.lpv),
-                                            vct_settings=vct_options(args.vct))
+        if args.samples == COMMITTED:
+            scene, (report, result, ref, mask) = compare_committed(name, args)
+        else:
+            build(name)
+            scene = extract_scene(bpy.context.evaluated_depsgraph_get())
+            report, result, ref, mask = compare(scene, args.method, args.samples, args.bounces,
+                                                progress=lambda m: None, lpv_options=parse_method_options(args.lpv),
+                                                vct_settings=vct_options(args.vct))
         if args.snapshot:
             add_snapshot(report, scene, args, result, ref, mask)
         add_ratios(report, result, ref, mask)
@@ -50,6 +58,27 @@ def main():
         out[name] = report
     sys.stdout.flush()
     print("RESULT " + json.dumps(out), flush=True)
+
+
+def compare_committed(name, args):
+    """(scene, (report, result, reference, mask)): ours against the committed reference of `name` with
+    args.bounces bounces; exits with a message where the reference does not belong to the scene built now."""
+    import bpy
+
+    from bounce_gi.addon.cli import parse_method_options, render_ours, vct_options
+    from bounce_gi.addon.reference.compare import compare_result
+    from examples import references
+
+    ref_name = references.transport_name(name, args.bounces)
+    ref = references.load(ref_name)
+    references.build(ref_name)
+    why = references.stale(ref)
+    if why:
+        raise SystemExit(why)
+    scene = extract_scene(bpy.context.evaluated_depsgraph_get())
+    result = render_ours(scene, args.method, parse_method_options(args.lpv), vct_options(args.vct))
+    report, mask = compare_result(scene, result, ref, args.method, ref.meta["samples"], args.bounces)
+    return scene, (report, result, ref, mask)
 
 
 def build(name):
