@@ -17,7 +17,9 @@ other eleven at 1024 x 2 took 3757 s (63 min; lamp_room 888 s and many_lights 84
 the fastest). At 2048 the whole set would have taken about 2.4 hours, so it is rendered at 1024 x 2 (furnished,
 the timing run, kept at 2048); each JSON records its samples and each pass's noise floor, which says what the
 lower count costs (at 1024 spp Combined's floor is 0.002-0.046, Diffuse Indirect's 0.017-0.067). Re-run with
---samples 2048 --force on a faster machine to lower the floors by about 1/sqrt(2).
+--samples 2048 --force on a faster machine to lower the floors by about 1/sqrt(2). The two rooms lit by the sky
+through a window are at 16384 (references.SAMPLES_OF: their 1024-spp Diffuse Direct floor was above the issue's
+target; 25 min each here, 2026-12-05).
 
 The transport tests' references (examples.references.TRANSPORT: cornell, spot_room, courtyard at 8 bounces and at 1)
 are rendered with 4096 samples (references.TRANSPORT_SAMPLES; 1.7-3 min each here, 2026-12-05): their tests hold

@@ -59,9 +59,13 @@ class ShadowSettings:
     pcf_radius: int = 1  # PCF kernel (2r+1)²
     # The world's light: shadow directions over the whole sphere (0: the world lights unshadowed) and texels per
     # side of each one's map. Many small maps rather than a few large ones: the sky's visibility is a quadrature
-    # over directions (its bands smoothed by direct/sky_filter.glsl), whose error the texel size hardly moves.
-    sky_directions: int = 384
-    sky_resolution: int = 192
+    # over directions (its bands smoothed by direct/sky_filter.glsl), and a glossy lobe sees the sky through a
+    # window in few of them. The texel matters too where the sky comes in through an opening: each map spans the
+    # whole scene, and a texel's depth step and bias at a window's edge and where walls meet are much of what a
+    # room's sky light is wrong by. The atlas holds 64 M texels: these maps take 29 M of it, leaving room for a
+    # sun's and 64 emitter sample cubes (benchmarks/results/llvmpipe/sky.md: the sweep and its cost).
+    sky_directions: int = 576
+    sky_resolution: int = 224
 
 
 @dataclass
