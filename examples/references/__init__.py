@@ -39,7 +39,7 @@ SAMPLES = 1024
 # The two rooms lit by the sky through an opening: Cycles samples a uniform world uniformly, so few of its paths
 # leave through the window, and at 1024 spp their Diffuse Direct noise floor (0.021, 0.037) was above the issue's
 # 0.02 target itself. At 16384 it is 0.003 (25 min each here, 2026-12-05). furnished: the timing run, kept at 2048.
-SAMPLES_OF = {"window_room": 16384, "furnished": 2048}
+SAMPLES_OF = {"window_room": 16384, "thin_walls": 16384, "furnished": 2048}
 BOUNCES = 8
 # The typical interiors of the transport tests (tests/accuracy/test_lpv_vs_cycles.py, test_vct_vs_cycles.py), each
 # against full-bounce Cycles and against one bounce: reference name -> (scene, Cycles' bounces), at frame 1.

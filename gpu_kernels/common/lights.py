@@ -51,7 +51,10 @@ class ShadowSettings:
     sun_resolution: int = 2048
     spot_resolution: int = 1024
     cube_resolution: int = 512  # per face, point lights
-    sample_cube_resolution: int = 256  # per face, area/emissive sample points
+    # Per face of the cube at each sample point: an area light's (its soft shadow is backprojected from the cube's
+    # texels, direct/eval.glsl patch_visibility, so their size is the penumbra's resolution) and an emitter's.
+    area_cube_resolution: int = 384
+    sample_cube_resolution: int = 256
     area_samples: int = 2  # n×n shadow sample points on square/rectangle lights (n² ring points on disks)
     # Shadow cubes for all emissive triangles together: they form ≤ budget/2 clusters (common/emitters.py), each
     # shadowed from 1–4 sample points on each of its two sides.
@@ -324,7 +327,7 @@ def _add_lamp(out: _Records, scene: Scene, light: Light, s: ShadowSettings) -> N
         v = []
         pts = area_sample_points(light, s.area_samples) if light.cast_shadow else []
         for point in pts:
-            v.extend(cube_views(point, s.sample_cube_resolution, *_near_far(scene, point),
+            v.extend(cube_views(point, s.area_cube_resolution, *_near_far(scene, point),
                                 np.asarray(light.direction, np.float64), area / len(pts)))
         out.add(LIGHT_POLYGON, radiance, poly.mean(axis=0), 0.0, light.direction, light_views=v,
                 samples=len(pts), per=6, poly=poly)

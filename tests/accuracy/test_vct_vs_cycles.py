@@ -18,13 +18,13 @@ per-pixel sub-rays (vct/crossing.glsl) with 9 cones (Cornell 0.117 / 0.060, spot
 import pytest
 
 # Measured 2026-12-05 against the 4096-spp references (rel-L1 Diffuse Indirect / Combined; noise floor DI / Combined),
-# defaults: cornell 0.1007 / 0.0531 (0.0114 / 0.0050), spot_room 0.0526 / 0.0196 (0.0127 / 0.0047), courtyard
+# defaults: cornell 0.1001 / 0.0512 (0.0114 / 0.0050), spot_room 0.0526 / 0.0196 (0.0127 / 0.0047), courtyard
 # 0.0922 / 0.0671 (0.0202 / 0.0136); the courtyard's Combined bound is the target, lower than the rule's 0.096.
-DEFAULT = {"cornell": {"diffuse_indirect": 0.125, "combined": 0.065},
+DEFAULT = {"cornell": {"diffuse_indirect": 0.124, "combined": 0.063},
            "spot_room": {"diffuse_indirect": 0.079, "combined": 0.030},
            "courtyard": {"diffuse_indirect": 0.134, "combined": 0.080}}
-# 1 bounce (against 8-bounce Cycles): cornell 0.4970 / 0.2306, spot_room 0.7129 / 0.2675, courtyard 0.6881 / 0.4667
-ONE = {"cornell": {"diffuse_indirect": 0.521, "combined": 0.242},
+# 1 bounce (against 8-bounce Cycles): cornell 0.4976 / 0.2305, spot_room 0.7129 / 0.2675, courtyard 0.6881 / 0.4667
+ONE = {"cornell": {"diffuse_indirect": 0.522, "combined": 0.242},
        "spot_room": {"diffuse_indirect": 0.740, "combined": 0.278},
        "courtyard": {"diffuse_indirect": 0.730, "combined": 0.495}}
 TARGETS = {"diffuse_indirect": 0.20, "combined": 0.08}  # the issue's; all three scenes meet both

@@ -194,7 +194,7 @@ def settings():
 
     return RenderSettings(method="none", width=160, height=120,
                           shadow=ShadowSettings(sun_resolution=512, spot_resolution=256, cube_resolution=128,
-                                                sample_cube_resolution=64))
+                                                area_cube_resolution=64, sample_cube_resolution=64))
 
 
 def _ray_hits_box(p, d, lo, hi):
