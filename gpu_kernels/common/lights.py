@@ -51,22 +51,14 @@ class ShadowSettings:
     sun_resolution: int = 2048
     spot_resolution: int = 1024
     cube_resolution: int = 512  # per face, point lights
-    # Per face of the cube at each sample point: an area light's (its soft shadow is backprojected from the cube's
-    # texels, direct/eval.glsl patch_visibility, so their size is the penumbra's resolution) and an emitter's.
-    area_cube_resolution: int = 384
-    sample_cube_resolution: int = 256
+    area_cube_resolution: int = 384  # per face at an area light's sample points (its soft shadows are read there)
+    sample_cube_resolution: int = 256  # per face at an emitter's sample points
     area_samples: int = 2  # n×n shadow sample points on square/rectangle lights (n² ring points on disks)
-    # Shadow cubes for all emissive triangles together: they form ≤ budget/2 clusters (common/emitters.py), each
-    # shadowed from 1–4 sample points on each of its two sides.
-    emissive_sample_budget: int = 64
+    emissive_sample_budget: int = 64  # cubes for all emitters: ≤ budget/2 clusters, 1–4 points on each side
     pcf_radius: int = 1  # PCF kernel (2r+1)²
-    # The world's light: shadow directions over the whole sphere (0: the world lights unshadowed) and texels per
-    # side of each one's map. Many small maps rather than a few large ones: the sky's visibility is a quadrature
-    # over directions (its bands smoothed by direct/sky_filter.glsl), and a glossy lobe sees the sky through a
-    # window in few of them. The texel matters too where the sky comes in through an opening: each map spans the
-    # whole scene, and a texel's depth step and bias at a window's edge and where walls meet are much of what a
-    # room's sky light is wrong by. The atlas holds 64 M texels: these maps take 29 M of it, leaving room for a
-    # sun's and 64 emitter sample cubes (benchmarks/results/llvmpipe/sky.md: the sweep and its cost).
+    # The world's light: shadow directions over the sphere (0: unshadowed; a quadrature, its bands smoothed by
+    # direct/sky_filter.glsl) and texels per side of each one's map, which spans the scene. 29 M of the atlas's 64 M
+    # texels, beside a sun's and 64 emitter cubes (benchmarks/results/llvmpipe/sky.md: the sweep and its cost).
     sky_directions: int = 576
     sky_resolution: int = 224
 

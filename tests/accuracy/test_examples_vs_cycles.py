@@ -95,7 +95,7 @@ BOUNDS = {
     },
     'metals': {
         'lpv': {'Combined': 0.057, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.266, 'Diffuse Color': 0.003, 'Glossy Direct': 0.032, 'Glossy Indirect': 0.627, 'Glossy Color': 0.013, 'Diffuse Light': 0.027, 'Diffuse Color match': 0.998},
-        'vct': {'Combined': 0.044, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.248, 'Diffuse Color': 0.003, 'Glossy Direct': 0.032, 'Glossy Indirect': 0.525, 'Glossy Color': 0.013, 'Diffuse Light': 0.028, 'Diffuse Color match': 0.998},
+        'vct': {'Combined': 0.045, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.248, 'Diffuse Color': 0.003, 'Glossy Direct': 0.032, 'Glossy Indirect': 0.525, 'Glossy Color': 0.013, 'Diffuse Light': 0.028, 'Diffuse Color match': 0.998},
     },
     'textured': {
         'lpv': {'Combined': 0.015, 'Diffuse Direct': 0.002, 'Diffuse Indirect': 0.110, 'Diffuse Color': 0.002, 'Diffuse Light': 0.015, 'Diffuse Color match': 0.998},
@@ -126,16 +126,16 @@ BOUNDS = {
         'vct': {'Combined': 0.048, 'Diffuse Direct': 0.016, 'Diffuse Indirect': 0.273, 'Diffuse Color': 0.003, 'Glossy Direct': 0.048, 'Glossy Indirect': 0.666, 'Glossy Color': 0.033, 'Diffuse Light': 0.027, 'Diffuse Color match': 0.998},
     },
     'product_shot': {
-        'lpv': {'Combined': 0.041, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.033, 'Glossy Indirect': 0.604, 'Glossy Color': 0.016, 'Diffuse Light': 0.035, 'Diffuse Color match': 0.996},
-        'vct': {'Combined': 0.042, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.033, 'Glossy Indirect': 0.487, 'Glossy Color': 0.016, 'Diffuse Light': 0.039, 'Diffuse Color match': 0.996},
+        'lpv': {'Combined': 0.041, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.034, 'Glossy Indirect': 0.604, 'Glossy Color': 0.016, 'Diffuse Light': 0.035, 'Diffuse Color match': 0.996},
+        'vct': {'Combined': 0.041, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.034, 'Glossy Indirect': 0.488, 'Glossy Color': 0.016, 'Diffuse Light': 0.039, 'Diffuse Color match': 0.996},
     },
     'furnished': {
         'lpv': {'Combined': 0.080, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.035, 'Glossy Indirect': 0.255, 'Glossy Color': 0.025, 'Emission': 0.009, 'Diffuse Light': 0.090, 'Diffuse Color match': 0.998},
         'vct': {'Combined': 0.078, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.140, 'Diffuse Color': 0.003, 'Glossy Direct': 0.035, 'Glossy Indirect': 0.236, 'Glossy Color': 0.025, 'Emission': 0.009, 'Diffuse Light': 0.080, 'Diffuse Color match': 0.998},
     },
     'cornell_animated': {
-        'lpv': {'Combined': 0.043, 'Diffuse Direct': 0.010, 'Diffuse Indirect': 0.089, 'Diffuse Color': 0.002, 'Diffuse Light': 0.043, 'Diffuse Color match': 0.999},
-        'vct': {'Combined': 0.064, 'Diffuse Direct': 0.010, 'Diffuse Indirect': 0.138, 'Diffuse Color': 0.002, 'Diffuse Light': 0.064, 'Diffuse Color match': 0.999},
+        'lpv': {'Combined': 0.044, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.089, 'Diffuse Color': 0.002, 'Diffuse Light': 0.043, 'Diffuse Color match': 0.999},
+        'vct': {'Combined': 0.064, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.138, 'Diffuse Color': 0.002, 'Diffuse Light': 0.064, 'Diffuse Color match': 0.999},
     },
 }
 

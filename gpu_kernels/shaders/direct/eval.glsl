@@ -94,7 +94,7 @@ float cube_visibility(int first_view, vec3 p, vec3 geo_n) {
 }
 
 #define PATCH_GATHERS 8            // at most, per axis: 2×2 texels each, over the region a blocker can shadow
-#define MAX_SEARCH_TEXELS 64.0     // that region's half-width cap (texels)
+#define MAX_SEARCH_SHARE 0.25      // that region's half-width cap, as a share of the map's side (64 of 256 texels)
 
 // Atlas uv and stored depth (distance / far) of world point x in perspective view v.
 vec3 view_uv_depth(ShadowView v, vec3 x) {
@@ -130,7 +130,7 @@ float patch_visibility(int view_index, vec3 p, vec3 geo_n, vec3 to_light, float 
     float d_r = length(q - v.origin.xyz);
     float tau = v.info.x;                      // a texel's angle (texel world size at unit distance)
     // Blockers at a fifth of the distance or farther: 1/z − 1/d_r ≤ 4/d_r.
-    float search = min(4.0 * h / (d_r * tau), MAX_SEARCH_TEXELS);
+    float search = min(4.0 * h / (d_r * tau), MAX_SEARCH_SHARE * v.tile.z / u_atlas_texel.x);
     if (search < 2.0) return view_visibility_biased(view_index, p, geo_n, to_light, MAX_SLOPE);
     // The receiver plane's depth per atlas uv, from two points one texel apart on it.
     vec3 t1 = normalize(abs(geo_n.x) < 0.9 ? cross(geo_n, vec3(1, 0, 0)) : cross(geo_n, vec3(0, 1, 0)));
