@@ -34,7 +34,8 @@ def engine():
 
 
 def _render(engine, scene, size=(40, 30), **kw):
-    settings = RenderSettings("vct", *size, vct=VctSettings(**{"resolution": 32, **kw}))
+    """The cone estimator at every pixel (indirect_scale 1; tests/gpu/test_vct_upsample.py checks the upsampling)."""
+    settings = RenderSettings("vct", *size, vct=VctSettings(**{"resolution": 32, "indirect_scale": 1, **kw}))
     return engine.render(scene, settings)
 
 
@@ -334,7 +335,8 @@ def test_defaults_are_valid_and_keys_separate_passes():
     assert VctSettings(diffuse_cones=19).key("trace") != s.key("trace")
     assert VctSettings(diffuse_cones=19, bounce_cones=0).key("bounce") != VctSettings(bounce_cones=0).key("bounce")
     assert s.specular_cone  # on by default: pixels with no glossy closure skip it (vct/specular.py)
-    for change in (dict(indirect_scale=2), dict(temporal_frames=4), dict(cone_rotation=10.0), dict(subrays=5)):
+    assert s.indirect_scale == 2  # the diffuse cones at every other pixel, upsampled (vct/upsample.py)
+    for change in (dict(indirect_scale=1), dict(temporal_frames=4), dict(cone_rotation=10.0), dict(subrays=5)):
         assert VctSettings(**change).key("trace") != s.key("trace") and VctSettings(**change).key("specular") == \
             s.key("specular") and VctSettings(**change).key("bounce") == s.key("bounce")
     assert VctSettings(roughness_cutoff=0.2).key("specular") != s.key("specular")

@@ -19,7 +19,7 @@ def engine():
 
 
 def _render(engine, scene, size=(40, 30), **kw):
-    return engine.render(scene, RenderSettings("vct", *size, vct=VctSettings(**{"resolution": 32, **kw})))
+    return engine.render(scene, RenderSettings("vct", *size, vct=VctSettings(**{"resolution": 32, "indirect_scale": 1, **kw})))
 
 
 def test_a_room_turned_off_the_grid_keeps_its_light(engine):
