@@ -15,23 +15,27 @@ tan(FLAT_DEGREES) × its diameter — a shade's two caps, opposite walls) is spl
 are flat or there are max_clusters; then any, the largest scatter first, until there are max_clusters / 4: flat
 clusters are better served by more sample points than by more clusters.
 
-Each cluster side gets 1 … MAX_SAMPLES_PER_SIDE sample points (the spare budget by emitted power), each
+Each cluster side gets 1 … MAX_SAMPLES_PER_SIDE sample points (the spare budget by emitted power; twice as many
+on the one side of a closed shell), each
 at the centre of a k-means cell of the cluster's area, snapped onto the surface (a curved cluster's mean point lies
 inside it), with the normal of the triangle it lies on and the share of the cluster's area it stands for. Both sides
-of the surface get a sample there (emission is two-sided, as in Cycles), nudged off it by 1e-3 of the triangle's
-size so the surface does not shadow its own sample. A closed shell's inner samples see only its inside, so the light
-emitted inwards never reaches the room.
+of the surface get a sample there (emission is two-sided, as in Cycles; a closed shell's inner side none, see
+below), nudged off it by 1e-3 of the triangle's size so the surface does not shadow its own sample.
 
 Trapped light. A closed emissive surface (every edge of a connected set of emissive triangles shared by an even
 number of them) — a closed lamp shade, with or without a bulb or the end of the lamp's pole inside — emits half its
 light inwards, and that light can only ever light the inside, which no camera outside sees (a shell around the
-camera, like the white furnace's box or an emissive dome around the scene, traps nothing). Its inner samples are marked `trapped`: the Diffuse Direct pass still lights the
-inside exactly, but the indirect methods leave that light out (VCT's injection sees trapped samples as shadowed, the
-LPV renders no RSM for them), because the voxels would let it out: a thin shell is not opaque at VCT's coarse mip
-levels nor in the LPV's fuzzy occlusion, so the light reflected inside reached the room as well (in
-tests/support/emitter_scenes.lamp_room_albedo, with every triangle shadowed but the inner light kept, Diffuse
-Indirect was 2.9× Cycles' with VCT and 1.5× with the LPV). Inside and outside are told apart by the parity of ray
-crossings (three rays, the majority wins).
+camera, like the white furnace's box or an emissive dome around the scene, traps nothing). So such a shell emits
+outwards only: its triangles are wound outwards (common/shells.outward) and marked one-sided, and its inner samples,
+marked `trapped`, get no shadow cube (common/lights.py), so they take no part in any pass.
+Lit two-sided, the receivers outside got the inner sides of the far triangles in their exact integral, and the
+samples' weights had to take that share out again, which they do only roughly (a floor under a shade: rel-L1 0.005
+against the exact integral, below 0.0001 one-sided, tests/gpu/test_emitters.py); the cubes the inner side no longer
+needs go to more points on the outer side (samples_per_side). And the voxels would let the inner light
+out: a thin shell is not opaque at VCT's coarse mip levels nor in the LPV's fuzzy occlusion (in
+tests/support/emitter_scenes.lamp_room_albedo, with the inner light kept, Diffuse Indirect was 2.9× Cycles' with VCT
+and 1.5× with the LPV). Inside and outside are told apart by the parity of ray crossings (three rays, the majority
+wins).
 """
 from __future__ import annotations
 
@@ -39,6 +43,8 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+
+from .shells import inside_closed, mesh_components, outward
 
 MAX_SAMPLES_PER_SIDE = 4  # penumbra sample points per cluster side (an area light has 2×2 by default)
 NORMAL_WEIGHT = 2.0  # weight of axis(normal) against centroid / L in the clustering features (module docstring)
@@ -62,6 +68,7 @@ class EmitterCluster:
     sample_sizes: np.ndarray  # (S,) sqrt of the area of the triangle each lies on (the nudge's scale)
     sample_trapped: np.ndarray = None  # (S, 2) bool: the side (+n, −n) faces the sealed inside of a closed emitter
     sample_component: np.ndarray = None  # (S,) the trapping shell each sample lies on (−1: none)
+    one_sided: np.ndarray = None  # (T,) emits along its winding normal only (a trapping shell's, wound outwards)
 
 
 def emissive_triangles(scene) -> tuple[np.ndarray, np.ndarray]:
@@ -202,18 +209,23 @@ def sample_points(tri: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray, 
     return points[snapped], owner[snapped], np.array(share)
 
 
-def samples_per_side(areas: np.ndarray, budget: int) -> np.ndarray:
+def samples_per_side(areas: np.ndarray, budget: int, one_sided: np.ndarray | None = None) -> np.ndarray:
     """Sample points per side for clusters of these powers (or areas): one each, then the spare budget (in sample
-    points per side) by largest remainder of the share, at most MAX_SAMPLES_PER_SIDE each."""
+    points on both sides) by largest remainder of the share, at most MAX_SAMPLES_PER_SIDE on each side. A
+    `one_sided` cluster (a closed shell's: its inner side gets no cube) pays half for a point and may have twice as
+    many: the same shadow cubes."""
+    cost = np.where(np.zeros(len(areas), bool) if one_sided is None else one_sided, 0.5, 1.0)
+    cap = MAX_SAMPLES_PER_SIDE / cost
     n = np.ones(len(areas), np.int64)
-    spare = budget - len(areas)
-    while spare > 0 and (n < MAX_SAMPLES_PER_SIDE).any():
-        open_ = n < MAX_SAMPLES_PER_SIDE
-        want = np.where(open_, areas / areas[open_].sum() * (spare + n[open_].sum()) - n, -np.inf)
-        k = int(np.argmax(want))
+    spare = budget - cost.sum()
+    while True:
+        open_ = (n < cap) & (cost <= spare + 1e-9)
+        if not open_.any():
+            return n
+        units = areas / areas[open_].sum() * (spare + (n * cost)[open_].sum())  # each one's share of the budget
+        k = int(np.argmax(np.where(open_, units / cost - n, -np.inf)))
         n[k] += 1
-        spare -= 1
-    return n
+        spare -= cost[k]
 
 
 def cluster_emitters(scene, max_clusters: int, samples_budget: int,
@@ -230,10 +242,13 @@ def cluster_emitters(scene, max_clusters: int, samples_budget: int,
     where = {t: i for i, t in enumerate(idx.tolist())}
     for k, shell in enumerate(trapping):
         component[[where[t] for t in np.asarray(shell).tolist() if t in where]] = k
+        # Its triangles emit outwards only (see the module docstring): wound so that their normals point out.
+        tri_all[component == k] = outward(tri_all[component == k])
     power = _areas(tri_all) * radiance.mean(axis=1)
     cap = min(max_clusters, samples_budget)
     groups = cluster_triangles(tri_all, cap, max(1, cap // 4), power)
-    per_side = samples_per_side(np.array([power[g].sum() for g in groups]), samples_budget)
+    per_side = samples_per_side(np.array([power[g].sum() for g in groups]), samples_budget,
+                                np.array([bool((component[g] >= 0).all()) for g in groups]))
     out = []
     for g, n_samples in zip(groups, per_side):
         tri = tri_all[g]
@@ -247,6 +262,7 @@ def cluster_emitters(scene, max_clusters: int, samples_budget: int,
         c = EmitterCluster(idx[g], tri, radiance[g], normal, (a[:, None] * tri.mean(axis=1)).sum(0) / a.sum(),
                            float(a.sum()), pts, unit[owner], share, np.sqrt(a[owner]))
         c.sample_trapped = np.zeros((len(pts), 2), bool)
+        c.one_sided = component[g] >= 0
         c.sample_component = component[g[owner]]
         out.append(c)
     for comp in range(len(trapping)):  # every sample on a trapping shell: which of its two sides faces the inside
@@ -278,77 +294,6 @@ def side_samples(cluster: EmitterCluster) -> list[tuple[np.ndarray, np.ndarray, 
 
 
 # --------------------------------------------------------------------------- closed emitters (trapped light)
-
-RAY_DIRECTIONS = np.array([[0.5773, 0.6124, 0.5400], [-0.7071, 0.3090, 0.6360], [0.2113, -0.8660, 0.4532]])
-RAY_DIRECTIONS /= np.linalg.norm(RAY_DIRECTIONS, axis=1, keepdims=True)
-PARITY_CHUNK = 1 << 22  # point × triangle pairs per numpy step
-
-
-def mesh_components(tri: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Connected components of triangles (T, 3, 3) that share edges (vertices equal bit for bit, as a mesh's
-    shared vertices are after extraction), and per component whether it is closed: every edge used an even number
-    of times."""
-    count = len(tri)
-    verts = np.ascontiguousarray(tri.reshape(-1, 3).astype(np.float32))
-    _, vid = np.unique(verts.view(np.dtype((np.void, 12))).ravel(), return_inverse=True)
-    vid = vid.reshape(count, 3)
-    edges = np.sort(np.stack([vid[:, [0, 1]], vid[:, [1, 2]], vid[:, [2, 0]]], axis=1), axis=2).reshape(-1, 2)
-    owner = np.repeat(np.arange(count), 3)
-    key = edges[:, 0].astype(np.int64) * (int(vid.max()) + 1) + edges[:, 1]
-    order = np.argsort(key, kind="stable")
-    key, owner = key[order], owner[order]
-    same = key[1:] == key[:-1]
-    _, comp = np.unique(_union_find(count, owner[:-1][same], owner[1:][same]), return_inverse=True)
-    starts = np.concatenate([[True], key[1:] != key[:-1]])
-    uses = np.diff(np.concatenate([np.nonzero(starts)[0], [len(key)]]))
-    odd_edge_owner = owner[np.nonzero(starts)[0][uses % 2 == 1]]
-    closed = np.ones(comp.max() + 1, bool)
-    closed[comp[odd_edge_owner]] = False
-    return comp, closed
-
-
-def _union_find(count: int, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Root (smallest member) of each of `count` elements joined by the pairs (a, b): hooking of roots onto the
-    smaller root, then full path compression, until no pair spans two roots (a few rounds, vectorised)."""
-    parent = np.arange(count)
-    while True:
-        ra, rb = parent[a], parent[b]
-        apart = ra != rb
-        if not apart.any():
-            return parent
-        lo, hi = np.minimum(ra[apart], rb[apart]), np.maximum(ra[apart], rb[apart])
-        np.minimum.at(parent, hi, lo)
-        while True:
-            nxt = parent[parent]
-            if np.array_equal(nxt, parent):
-                break
-            parent = nxt
-
-
-def _crossings(points: np.ndarray, tri: np.ndarray, direction: np.ndarray) -> np.ndarray:
-    """Number of triangles the ray points + t·direction (t > 0) crosses, per point (Möller–Trumbore)."""
-    out = np.zeros(len(points), np.int64)
-    e1, e2 = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
-    pvec = np.cross(direction, e2)
-    det = (e1 * pvec).sum(1)
-    ok = np.abs(det) > 1e-30
-    e1, e2, v0, pvec, inv = e1[ok], e2[ok], tri[ok, 0], pvec[ok], 1.0 / det[ok]
-    step = max(1, PARITY_CHUNK // max(len(v0), 1))
-    for s in range(0, len(points), step):
-        tvec = points[s:s + step, None] - v0[None]
-        u = (tvec * pvec).sum(-1) * inv
-        qvec = np.cross(tvec, e1[None])
-        v = (qvec * direction).sum(-1) * inv
-        t = (qvec * e2[None]).sum(-1) * inv
-        out[s:s + step] = ((u >= 0) & (v >= 0) & (u + v <= 1) & (t > 0)).sum(1)
-    return out
-
-
-def inside_closed(shell: np.ndarray, points: np.ndarray) -> np.ndarray:
-    """Whether each point lies inside the closed surface `shell` (T, 3, 3): odd crossings, majority of three rays."""
-    votes = sum((_crossings(points, shell, d) % 2 == 1).astype(int) for d in RAY_DIRECTIONS)
-    return votes >= 2
-
 
 def sealed_shells(scene) -> list[np.ndarray]:
     """The closed emissive surfaces of `scene`, as arrays of triangle indices: connected emissive triangles every

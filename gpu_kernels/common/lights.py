@@ -57,8 +57,7 @@ class ShadowSettings:
     emissive_sample_budget: int = 64  # cubes for all emitters: ≤ budget/2 clusters, 1–4 points on each side
     pcf_radius: int = 1  # PCF kernel (2r+1)²
     # The world's light: shadow directions over the sphere (0: unshadowed; a quadrature, its bands smoothed by
-    # direct/sky_filter.glsl) and texels per side of each one's map, which spans the scene. 29 M of the atlas's 64 M
-    # texels, beside a sun's and 64 emitter cubes (benchmarks/results/llvmpipe/sky.md: the sweep and its cost).
+    # direct/sky_filter.glsl) and texels per side of each one's map (benchmarks/results/llvmpipe/sky.md: the sweep).
     sky_directions: int = 576
     sky_resolution: int = 224
 
@@ -74,8 +73,7 @@ class ShadowView:
     view_matrix: np.ndarray | None = None  # world → view (rows: right, up, −forward)
     half_extent: float = 0.0  # tan(half fov) (perspective) or half width in metres (orthographic)
     # Polygon lights' sample points: the normal the light emits along there and the share of the light's area the
-    # point stands for (the weights of direct/eval.glsl's polygon_visibility), negative where the sample faces the
-    # sealed inside of a closed emitter (its light is trapped there: common/emitters.py); zero for other lights.
+    # point stands for (the weights of direct/eval.glsl's polygon_visibility); zero for other lights.
     emit_normal: np.ndarray | None = None
     emit_share: float = 0.0
     pcf_radius: int | None = None  # this view's PCF radius, where not ShadowSettings.pcf_radius (the sky's: 0)
@@ -327,30 +325,31 @@ def _add_lamp(out: _Records, scene: Scene, light: Light, s: ShadowSettings) -> N
         out.warnings.append(f"light '{light.name}' of type {light.type} is not supported and is ignored")
 
 
-def triangle_list_vertices(vertices: np.ndarray, radiance: np.ndarray, color: np.ndarray) -> np.ndarray:
+def triangle_list_vertices(vertices: np.ndarray, radiance: np.ndarray, color: np.ndarray,
+                           one_sided: np.ndarray | None = None) -> np.ndarray:
     """(4T, 4) polygon-buffer rows of a triangle list: per triangle its three vertices (w = 1), then its radiance
-    relative to the light record's colour (rgb; w = 0). shaders/common/light_eval.glsl reads them."""
+    relative to the light record's colour (rgb; w = 1 where it emits along its winding normal only, else 0).
+    shaders/common/light_eval.glsl reads them."""
     t = len(vertices)
     out = np.zeros((t, 4, 4))
     out[:, :3, :3] = vertices
     out[:, :3, 3] = 1.0
     out[:, 3, :3] = np.divide(radiance, color, out=np.zeros_like(radiance), where=color > 0)
+    out[:, 3, 3] = 0.0 if one_sided is None else one_sided
     return out.reshape(-1, 4)
 
 
 def _add_emissive(out: _Records, scene: Scene, s: ShadowSettings, trapping: list | None) -> None:
     """Every emissive triangle, in ≤ emissive_sample_budget/2 two-sided polygon lights (common/emitters.py), each
-    shadowed from its sample points on both sides of the surface."""
+    shadowed from its sample points on both sides of the surface (not the trapped inner side of a closed one)."""
     half = max(1, s.emissive_sample_budget // 2)
     for c in em.cluster_emitters(scene, half, half, trapping):
         color = c.radiance.max(axis=0)
-        v, samples = [], em.side_samples(c)
-        for point, normal, share, trapped in samples:
-            # A trapped sample's share is stored negative (direct/eval.glsl, common/emitters.py: trapped light).
-            v.extend(cube_views(point, s.sample_cube_resolution, *_near_far(scene, point), normal,
-                                (-1.0 if trapped else 1.0) * share / c.area))
+        v, samples = [], [sample for sample in em.side_samples(c) if not sample[3]]
+        for point, normal, share, _ in samples:
+            v.extend(cube_views(point, s.sample_cube_resolution, *_near_far(scene, point), normal, share / c.area))
         out.add(LIGHT_POLYGON, color, c.centroid, 0.0, c.normal, light_views=v, samples=len(samples), per=6,
-                poly=triangle_list_vertices(c.vertices, c.radiance, color), two_sided=True)
+                poly=triangle_list_vertices(c.vertices, c.radiance, color, c.one_sided), two_sided=True)
 
 
 def pack_views(views: list[ShadowView], tiles: list[tuple], atlas_size: tuple[int, int], pcf_radius: int,

@@ -100,18 +100,16 @@ def bind_grid(prog, grid, levels: int | None = None) -> None:
 RAW_DEPTH_UNIT = 31
 
 
-def bind_lights(prog, shadows, unit: int, exclude_trapped: bool = False, sky_stride: int = 1) -> int:
+def bind_lights(prog, shadows, unit: int, sky_stride: int = 1) -> int:
     """The lights, shadow views, polygons and shadow atlas of direct/eval.glsl (storage buffers 0–2, the atlas on
-    texture unit `unit`); returns the next free unit. exclude_trapped: the light trapped inside closed emitters is
-    left out (the indirect methods' injection; common/emitters.py). sky_stride: the sky is shadowed from every
-    sky_stride-th of its directions (the injection's: common/lights.SKY_INJECTION_STRIDE)."""
+    texture unit `unit`); returns the next free unit. sky_stride: the sky is shadowed from every sky_stride-th of
+    its directions (the injection's: common/lights.SKY_INJECTION_STRIDE)."""
 
     shadows.depth.use(location=unit)
     set_uniform(prog, "u_shadow_atlas", unit)
     if "u_shadow_depth" in prog:
         shadows.raw_depth().use(location=RAW_DEPTH_UNIT)
         set_uniform(prog, "u_shadow_depth", RAW_DEPTH_UNIT)
-    set_uniform(prog, "u_exclude_trapped", bool(exclude_trapped))
     set_uniform(prog, "u_sky_stride", int(sky_stride))
     set_uniform(prog, "u_atlas_texel", (1.0 / shadows.size[0], 1.0 / shadows.size[1]))
     set_uniform(prog, "u_light_count", shadows.light_count)

@@ -79,16 +79,12 @@ def view_resolution(resolution: int, ortho: bool, samples: int, width: float = 0
 
 
 def render_rsm(ctx, programs, scene: Scene, geometry, textures, shadows, resolution: int, texel: float = 0.0) -> Rsm:
-    """Render every shadow view of every light once more as an RSM (position, normal, albedo) into an atlas —
-    except the views of samples whose light is trapped inside a closed emitter (common/emitters.py): their VPLs
-    would light only its inside, and the volume would let that light out. `texel` (m, > 0): the finest texel an
-    orthographic view needs (view_resolution)."""
+    """Render every shadow view of every light once more as an RSM (position, normal, albedo) into an atlas.
+    `texel` (m, > 0): the finest texel an orthographic view needs (view_resolution)."""
     import moderngl
 
     buffers = shadows.buffers
-    kept = [i for i, v in enumerate(buffers.views) if not v.emit_share < 0]
-    views = [buffers.views[i] for i in kept]
-    view_lights = [buffers.view_lights[i] for i in kept]
+    views, view_lights = buffers.views, buffers.view_lights
     res = [view_resolution(resolution, v.ortho, int(buffers.lights[light]["params"][2]), 2 * v.half_extent, texel)
            for v, light in zip(views, view_lights)]
     tiles, size, scale = lb.allocate_atlas(res, max_height=ctx.info.get("GL_MAX_TEXTURE_SIZE", 16384))
@@ -116,7 +112,7 @@ def render_rsm(ctx, programs, scene: Scene, geometry, textures, shadows, resolut
         draw_by_material(prog, scene, geometry, textures, vao=vao)
         light = view_lights[i]
         rec = buffers.lights[light]
-        k = (kept[i] - int(rec["params"][1])) // max(int(rec["params"][3]), 1)
+        k = (i - int(rec["params"][1])) // max(int(rec["params"][3]), 1)
         records[i]["params"] = (0.0 if view.ortho else view.half_extent,
                                 2 * view.half_extent / w if view.ortho else 0.0, light, k)
         records[i]["origin"] = (*view.origin, 1.0 if view.ortho else 0.0)

@@ -47,7 +47,7 @@ def inject(ctx, programs, scene: Scene, geometry, textures: list, vox, shadows, 
             for defines in (({"MODE_FRONT": None},) if fronts else ()) + ({},):
                 prog = programs.raster("vct/inject_raster.glsl", defines)
                 bind_grid(prog, grid, 1)
-                bind_lights(prog, shadows, unit=2, exclude_trapped=True, sky_stride=SKY_INJECTION_STRIDE)
+                bind_lights(prog, shadows, unit=2, sky_stride=SKY_INJECTION_STRIDE)
                 set_uniforms(prog, {"u_samples": float(INJECT_SAMPLES), "u_viewport": (float(side), float(side)),
                                     "u_cover_test": bool(fronts)})
                 acc.bind_to_image(0, read=True, write=True)
@@ -64,7 +64,7 @@ def inject(ctx, programs, scene: Scene, geometry, textures: list, vox, shadows, 
             unit = bind_samplers(prog, "u_area", [vox.area], 0)
             unit = bind_samplers(prog, "u_albedo", [vox.albedo], unit)
             unit = bind_samplers(prog, "u_acc", [acc], unit)
-            bind_lights(prog, shadows, unit, exclude_trapped=True, sky_stride=SKY_INJECTION_STRIDE)
+            bind_lights(prog, shadows, unit, sky_stride=SKY_INJECTION_STRIDE)
             bind_grid(prog, grid, 1)
             for i, t in enumerate(outputs):
                 t.bind_to_image(i, read=False, write=True)

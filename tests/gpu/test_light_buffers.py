@@ -113,7 +113,7 @@ def test_gpu_reads_numpy_records_field_for_field(gl_context, tmp_path):
     # Views made the way the pipeline makes them: row-major float64 matrices packed by pack_views.
     views = [lb.ShadowView(rng.uniform(-2, 2, (4, 4)), rng.uniform(-5, 5, 3), bool(i % 2), 0.01 * (i + 1), 256,
                            far=3.0 + i) for i in range(2)]
-    views[1].emit_normal, views[1].emit_share = np.array([0.0, 0.6, -0.8]), -0.25  # a trapped polygon-light sample
+    views[1].emit_normal, views[1].emit_share = np.array([0.0, 0.6, -0.8]), 0.25  # a polygon-light sample
     tiles = [(0, 0, 256, 256), (256, 0, 256, 256)]  # tiles at the views' own resolution (atlas not scaled)
     packed = lb.pack_views(views, tiles, (512, 256), pcf_radius=2)
     polygon = rng.uniform(-1, 1, (5, 4)).astype(np.float32)

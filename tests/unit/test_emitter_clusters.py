@@ -8,6 +8,7 @@ import pytest
 
 from bounce_gi.gpu_kernels.common import emitters as em
 from bounce_gi.gpu_kernels.common import lights as lb
+from bounce_gi.gpu_kernels.common import shells
 from bounce_gi.gpu_kernels.scene import Camera, Material, Scene
 from bounce_gi.tests.support.synthetic import closed_cylinder
 
@@ -59,9 +60,12 @@ def test_every_emissive_triangle_is_in_exactly_one_cluster_and_the_cost_is_bound
     members = np.concatenate([c.triangles for c in clusters])
     assert sorted(members.tolist()) == sorted(idx.tolist())  # all covered, none twice
     assert len(clusters) <= budget // 2
-    assert sum(len(c.sample_points) for c in clusters) <= budget // 2  # sample points per side
+    # Sample points: two cubes each (one per side), or one on a closed shell, which emits outwards only and may have
+    # twice as many points (common/emitters.samples_per_side).
+    cubes = sum(len(c.sample_points) * (1 if c.one_sided.all() else 2) for c in clusters)
+    assert cubes <= budget
     for c in clusters:
-        assert 1 <= len(c.sample_points) <= em.MAX_SAMPLES_PER_SIDE
+        assert 1 <= len(c.sample_points) <= em.MAX_SAMPLES_PER_SIDE * (2 if c.one_sided.all() else 1)
         assert c.sample_areas.sum() == pytest.approx(c.area, rel=1e-9)
     buffers = lb.build_light_buffers(scene, lb.ShadowSettings(emissive_sample_budget=budget))
     assert len(buffers.views) <= 6 * budget  # shadow cubes within the budget
@@ -117,17 +121,24 @@ def test_a_cluster_may_mix_materials_and_keeps_each_triangle_s_radiance():
     assert total == 80
 
 
-def test_views_carry_each_sample_s_normal_and_share():
-    scene = scene_of((cylinder(), lamp()))
-    buffers = lb.build_light_buffers(scene)
+@pytest.mark.parametrize("caps", [False, True])
+def test_views_carry_each_sample_s_normal_and_share(caps):
+    """An open cylinder emits from both sides: the two sides of each sample point emit along opposite normals, and
+    each side's shares sum to 1. A closed one (with its caps) emits outwards only: one sample per point, facing out."""
+    centre = np.array([0.0, 0.0, 1.5])
+    buffers = lb.build_light_buffers(scene_of((cylinder(caps=caps), lamp())))
     packed = lb.pack_views(buffers.views, [(0, 0, 16, 16)] * len(buffers.views), (16, 16), 1, buffers.view_lights)
     for i, rec in enumerate(buffers.lights):
         first, samples, per = int(rec["params"][1]), int(rec["params"][2]), int(rec["params"][3])
         e = packed["emitter"][first:first + samples * per:per]
         np.testing.assert_allclose(np.linalg.norm(e[:, :3], axis=1), 1.0, rtol=1e-6)
-        # The two sides of each sample point emit along opposite normals; each side's shares sum to 1.
-        np.testing.assert_allclose(e[0::2, :3], -e[1::2, :3], atol=1e-6)
-        assert np.abs(e[0::2, 3]).sum() == pytest.approx(1.0, rel=1e-5)
+        if not caps:
+            np.testing.assert_allclose(e[0::2, :3], -e[1::2, :3], atol=1e-6)
+            assert e[0::2, 3].sum() == pytest.approx(1.0, rel=1e-5)
+        else:
+            origins = np.array([buffers.views[first + k * per].origin for k in range(samples)])
+            assert np.all(((origins - centre) * e[:, :3]).sum(axis=1) > 0)
+            assert e[:, 3].sum() == pytest.approx(1.0, rel=1e-5)
 
 
 # --------------------------------------------------------------------------- closed emitters: trapped light
@@ -171,16 +182,52 @@ def test_what_lies_inside_a_closed_shade_does_not_open_it():
 
 
 def test_closedness_needs_every_edge_shared():
-    comp, closed = em.mesh_components(cylinder().astype(np.float64))
+    comp, closed = shells.mesh_components(cylinder().astype(np.float64))
     assert closed.tolist() == [True] and set(comp.tolist()) == {0}
-    comp, closed = em.mesh_components(cylinder()[:-1].astype(np.float64))  # one cap triangle missing
+    comp, closed = shells.mesh_components(cylinder()[:-1].astype(np.float64))  # one cap triangle missing
     assert closed.tolist() == [False]
     two = np.concatenate([cylinder(), cylinder(centre=(2, 0, 1.5))]).astype(np.float64)
-    comp, closed = em.mesh_components(two)
+    comp, closed = shells.mesh_components(two)
     assert closed.tolist() == [True, True] and comp[0] != comp[-1]
 
 
 def test_inside_closed_by_ray_parity():
     shell = cylinder(centre=(0, 0, 0)).astype(np.float64)
     points = np.array([[0, 0, 0], [0.21, 0, 0.1], [0.23, 0, 0], [0, 0, 0.17], [5, 5, 5]], np.float64)
-    assert em.inside_closed(shell, points).tolist() == [True, True, False, False, False]
+    assert shells.inside_closed(shell, points).tolist() == [True, True, False, False, False]
+
+
+@pytest.mark.parametrize("flipped", ["none", "some", "all"])
+def test_a_closed_shell_is_wound_outwards_whatever_its_windings(flipped):
+    """shells.outward turns every triangle of a closed surface to face out, from any mix of windings: two shades,
+    one of them half flipped at random, the other wholly, and every normal must point away from its own shade's axis
+    (sides) or centre plane (caps)."""
+    centres = [np.array([0.0, 0.0, 1.5]), np.array([2.0, 0.0, 1.5])]
+    tri = np.concatenate([cylinder(centre=tuple(c)) for c in centres]).astype(np.float64)
+    half = len(tri) // 2
+    flip = {"none": np.zeros(len(tri), bool), "some": np.random.default_rng(3).random(len(tri)) < 0.5,
+            "all": np.arange(len(tri)) >= half}[flipped]
+    tri[flip] = tri[flip][:, [0, 2, 1]]
+    out = shells.outward(tri)
+    normal = np.cross(out[:, 1] - out[:, 0], out[:, 2] - out[:, 0])
+    centre = np.where((np.arange(len(tri)) < half)[:, None], centres[0], centres[1])
+    away = out.mean(axis=1) - centre
+    side = np.abs(normal[:, 2]) < 0.5 * np.linalg.norm(normal, axis=1)
+    away[side, 2] = 0.0  # a side's normal points away from the axis
+    away[~side, :2] = 0.0  # a cap's away from the middle
+    assert np.all((normal * away).sum(axis=1) > 0)
+    assert np.allclose(np.sort(out.reshape(len(out), -1), axis=1), np.sort(tri.reshape(len(tri), -1), axis=1))
+
+
+def test_a_closed_emitter_emits_outwards_only_and_creates_no_trapped_cubes():
+    """The shade's triangles are one-sided (common/emitters.py: its inner light stays inside), and the light
+    buffers hold cubes only for its outer samples; an open cylinder stays two-sided."""
+    closed = scene_of((cylinder(), lamp()), (floor(), Material("floor")))
+    clusters = em.cluster_emitters(closed, 32, 32)
+    assert all(c.one_sided.all() for c in clusters)
+    buffers = lb.build_light_buffers(closed)
+    outer = sum(len(c.sample_points) for c in em.cluster_emitters(closed, 32, 32))
+    assert len(buffers.views) == 6 * outer
+    assert all(v.emit_share > 0 for v in buffers.views)
+    open_ = scene_of((cylinder(caps=False), lamp()), (floor(), Material("floor")))
+    assert not any(c.one_sided.any() for c in em.cluster_emitters(open_, 32, 32))

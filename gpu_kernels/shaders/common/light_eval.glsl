@@ -55,38 +55,47 @@ float polygon_projected_solid_angle(int first, int count, vec3 p, vec3 n) {
 }
 
 // A polygon light as triangles, whatever its layout (lights.glsl, GpuLight.polygon): a fan over one polygon's
-// vertices, or an emitter cluster's list; `scale` is the triangle's radiance relative to color_type.rgb. For code
-// that integrates something other than the cosine over the light (a glossy lobe).
+// vertices, or an emitter cluster's list; `scale` is the triangle's radiance relative to color_type.rgb (rgb) and
+// 1 where it emits along its winding normal (b − a) × (c − a) only (w: a closed emitter's, common/emitters.py). For
+// code that integrates something other than the cosine over the light (a glossy lobe).
 int polygon_triangle_count(GpuLight L) {
     return L.polygon.w > 0.5 ? int(L.polygon.y) / 4 : max(int(L.polygon.y) - 2, 0);
 }
 
-void polygon_triangle(GpuLight L, int t, out vec3 a, out vec3 b, out vec3 c, out vec3 scale) {
+void polygon_triangle(GpuLight L, int t, out vec3 a, out vec3 b, out vec3 c, out vec4 scale) {
     int first = int(L.polygon.x);
     if (L.polygon.w > 0.5) {
         a = polygon_vertices[first + 4 * t].xyz;
         b = polygon_vertices[first + 4 * t + 1].xyz;
         c = polygon_vertices[first + 4 * t + 2].xyz;
-        scale = polygon_vertices[first + 4 * t + 3].rgb;
+        scale = polygon_vertices[first + 4 * t + 3];
     } else {
         a = polygon_vertices[first].xyz;
         b = polygon_vertices[first + t + 1].xyz;
         c = polygon_vertices[first + t + 2].xyz;
-        scale = vec3(1.0);
+        scale = vec4(1.0, 1.0, 1.0, 0.0);
     }
 }
 
 // A polygon light's ∫ (radiance / color) cosθ dω at p: its polygon's projected solid angle, or for a triangle list
-// (an emitter cluster, polygon.w = 1) the sum over its triangles, each weighted by its own relative radiance.
-// Irradiance = color_type.rgb × this (unshadowed).
+// (an emitter cluster, polygon.w = 1) the sum over its triangles, each weighted by its own relative radiance, a
+// one-sided one only where p lies on the side it emits to. A point within SELF_PLANE of a triangle's size of its
+// plane lies on it: from just off its plane a triangle fills half the sky, and a position rasterised on the emitter
+// itself at a grazing angle is up to 1e-3 of its size off (measured: a lamp shade's RSM texels lit themselves, the
+// shade's first bounce 2.6× what the room reflected). Irradiance = color_type.rgb × this (unshadowed).
+#define SELF_PLANE 1e-2
 vec3 polygon_light_solid_angle(GpuLight L, vec3 p, vec3 n) {
     int first = int(L.polygon.x), count = int(L.polygon.y);
     if (L.polygon.w < 0.5) return vec3(polygon_projected_solid_angle(first, count, p, n));
     vec3 sum = vec3(0.0);
     for (int i = first; i < first + count; i += 4) {
-        float psa = triangle_projected_solid_angle(polygon_vertices[i].xyz - p, polygon_vertices[i + 1].xyz - p,
-                                                   polygon_vertices[i + 2].xyz - p, n);
-        sum += psa * polygon_vertices[i + 3].rgb;
+        vec3 a = polygon_vertices[i].xyz - p, b = polygon_vertices[i + 1].xyz - p, c = polygon_vertices[i + 2].xyz - p;
+        vec4 scale = polygon_vertices[i + 3];
+        vec3 tn = cross(b - a, c - a);
+        float len = length(tn);
+        float height = -dot(a, tn) / max(len, 1e-30);   // p above the triangle's plane, along its winding normal
+        if (abs(height) <= SELF_PLANE * sqrt(0.5 * len) || (scale.w > 0.5 && height < 0.0)) continue;
+        sum += triangle_projected_solid_angle(a, b, c, n) * scale.rgb;
     }
     return sum;
 }

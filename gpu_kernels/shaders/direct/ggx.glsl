@@ -55,8 +55,10 @@ vec3 polygon_glossy(sampler2D lut, GlossyLobe g, GpuLight L, vec3 p, vec3 n, vec
     float inv_k = 1.0 / float(k);
     vec3 sum = vec3(0.0);
     for (int t = 0; t < count; ++t) {
-        vec3 a, b, c, scale;
+        vec3 a, b, c;
+        vec4 scale;
         polygon_triangle(L, t, a, b, c, scale);
+        bool both_faces = two_sided && scale.w < 0.5;   // a closed emitter's triangles emit outwards only
         vec3 tn = cross(b - a, c - a);
         float len = length(tn);
         if (!(len > 0.0)) continue;
@@ -74,12 +76,12 @@ vec3 polygon_glossy(sampler2D lut, GlossyLobe g, GpuLight L, vec3 p, vec3 n, vec
                     float d2 = max(dot(w, w), 1e-10);
                     vec3 l = w * inversesqrt(d2);
                     float cos_e = -dot(emit_n, l);
-                    cos_e = two_sided ? abs(cos_e) : max(cos_e, 0.0);
+                    cos_e = both_faces ? abs(cos_e) : max(cos_e, 0.0);
                     if (cos_e > 0.0) tri += lobe_cos(lut, g, n, v, l) * (cos_e * sub_area / d2);
                 }
             }
         }
-        sum += scale * tri;
+        sum += scale.rgb * tri;
     }
     return L.color_type.rgb * sum;
 }

@@ -97,7 +97,7 @@ vec3 vpl_flux(RsmView v, vec3 p, vec3 n, vec3 albedo) {
         vec3 d = p - shadow_views[first + j * per].origin.xyz;
         float d2 = max(dot(d, d), 1e-8);
         vec3 w = d * inversesqrt(d2);
-        float cl = abs(e.w) * max(dot(e.xyz, w), 0.0);  // e.w < 0: trapped (lpv/rsm.py renders no RSM for it)
+        float cl = e.w * max(dot(e.xyz, w), 0.0);
         wsum += cl * max(dot(n, -w), 0.0) / d2;
         if (j == k) share_k = cl;
     }

@@ -12,8 +12,8 @@
 // A face that has coverage but caught no fragment (a sliver thinner than the raster's pixels) falls back to one
 // evaluation at the face centre with the face normal: L_g = albedo·E(centre + n_g·cell/2, n_g)/π.
 // Emission is not injected: emissive triangles are lights (common/lights.py), so E already carries their light,
-// and adding it again would count it twice (Cycles' Diffuse Indirect never holds emission). E leaves out the light
-// a closed emitter traps inside itself (u_exclude_trapped, common/emitters.py): it would leak out of the voxels.
+// and adding it again would count it twice (Cycles' Diffuse Indirect never holds emission). A closed emitter emits
+// outwards only (common/emitters.py): its inner light would leak out of the voxels.
 // MODE_CLEAR zeroes the accumulator; MODE_RESOLVE writes the faces: rgb = L_g, a = α_g, and centroids: xyz = c_g,
 // w = α_g (or the face centre and w = −α_g for a fallback face; w = 0 where the voxel has no surface).
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;  // gl/bind.VOLUME_GROUP

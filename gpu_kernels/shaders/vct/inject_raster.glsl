@@ -7,8 +7,8 @@
 // triangle's geometric normal n and its material's albedo as the voxelizer defines it (voxel/common.glsl
 // voxel_albedo: the diffuse and glossy layers' reflectance averaged over directions).
 // Fragment shader: for each side s = ±n the outgoing radiance L_s = albedo·E(p, s·n)/π, E the shadowed irradiance
-// of every light exactly as the Diffuse Direct pass computes it (direct/eval.glsl), less the light closed emitters
-// trap inside themselves (u_exclude_trapped; common/emitters.py). The side's light leaves the
+// of every light exactly as the Diffuse Direct pass computes it (direct/eval.glsl; closed emitters emit outwards
+// only, common/emitters.py). The side's light leaves the
 // voxel through the faces its normal points to: face g = (axis b, sign of s·n_b) receives weight
 // w = A·|n_b| (the fragment's area A projected onto that face's plane) and adds w·L_s, w and w·p to the face's
 // accumulator (vct/inject.glsl resolves the means). So a voxel holding a floor and a wall (an edge) gets the lit
