@@ -80,9 +80,10 @@ void polygon_triangle(GpuLight L, int t, out vec3 a, out vec3 b, out vec3 c, out
 // A polygon light's ∫ (radiance / color) cosθ dω at p: its polygon's projected solid angle, or for a triangle list
 // (an emitter cluster, polygon.w = 1) the sum over its triangles, each weighted by its own relative radiance, a
 // one-sided one only where p lies on the side it emits to. A point within SELF_PLANE of a triangle's size of its
-// plane lies on it: from just off its plane a triangle fills half the sky, and a position rasterised on the emitter
-// itself at a grazing angle is up to 1e-3 of its size off (measured: a lamp shade's RSM texels lit themselves, the
-// shade's first bounce 2.6× what the room reflected). Irradiance = color_type.rgb × this (unshadowed).
+// plane, over the triangle (not within 1e-3 of its edges: a wall's point beside a corner is over the edge of the
+// wall it meets, which lights it), lies on it: from just off its plane a triangle fills half the sky, and a position
+// rasterised on the emitter itself at a grazing angle is up to 1e-3 of its size off (measured: a lamp shade's RSM
+// texels lit themselves, the shade's first bounce 2.6× what the room reflected). Irradiance = color_type.rgb × this.
 #define SELF_PLANE 1e-2
 vec3 polygon_light_solid_angle(GpuLight L, vec3 p, vec3 n) {
     int first = int(L.polygon.x), count = int(L.polygon.y);
@@ -94,7 +95,9 @@ vec3 polygon_light_solid_angle(GpuLight L, vec3 p, vec3 n) {
         vec3 tn = cross(b - a, c - a);
         float len = length(tn);
         float height = -dot(a, tn) / max(len, 1e-30);   // p above the triangle's plane, along its winding normal
-        if (abs(height) <= SELF_PLANE * sqrt(0.5 * len) || (scale.w > 0.5 && height < 0.0)) continue;
+        vec3 edges = vec3(dot(cross(b - a, -a), tn), dot(cross(c - b, -b), tn), dot(cross(a - c, -c), tn));
+        bool over = min(edges.x, min(edges.y, edges.z)) > 1e-3 * len * len;   // barycentrics > 1e-3
+        if ((over && abs(height) <= SELF_PLANE * sqrt(0.5 * len)) || (scale.w > 0.5 && height < 0.0)) continue;
         sum += triangle_projected_solid_angle(a, b, c, n) * scale.rgb;
     }
     return sum;
