@@ -54,7 +54,7 @@ class ShadowSettings:
     area_cube_resolution: int = 384  # per face at an area light's sample points (its soft shadows are read there)
     sample_cube_resolution: int = 256  # per face at an emitter's sample points
     area_samples: int = 2  # n×n shadow sample points on square/rectangle lights (n² ring points on disks)
-    emissive_sample_budget: int = 64  # cubes for all emitters: ≤ budget/2 clusters, 1–4 points on each side
+    emissive_sample_budget: int = 64  # cubes for all emitters: ≤ budget/2 clusters (common/emitters.py)
     pcf_radius: int = 1  # PCF kernel (2r+1)²
     # The world's light: shadow directions over the sphere (0: unshadowed; a quadrature, its bands smoothed by
     # direct/sky_filter.glsl) and texels per side of each one's map (benchmarks/results/llvmpipe/sky.md: the sweep).

@@ -11,14 +11,20 @@ RAY_DIRECTIONS /= np.linalg.norm(RAY_DIRECTIONS, axis=1, keepdims=True)
 PARITY_CHUNK = 1 << 22  # point × triangle pairs per numpy step
 
 
+def _vertex_ids(tri: np.ndarray) -> np.ndarray:
+    """(T, 3) one id per distinct vertex position (equal bit for bit in float32, as a mesh's shared vertices are
+    after extraction)."""
+    verts = np.ascontiguousarray(tri.reshape(-1, 3).astype(np.float32))
+    _, vid = np.unique(verts.view(np.dtype((np.void, 12))).ravel(), return_inverse=True)
+    return vid.reshape(len(tri), 3)
+
+
 def mesh_components(tri: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Connected components of triangles (T, 3, 3) that share edges (vertices equal bit for bit, as a mesh's
     shared vertices are after extraction), and per component whether it is closed: every edge used an even number
     of times."""
     count = len(tri)
-    verts = np.ascontiguousarray(tri.reshape(-1, 3).astype(np.float32))
-    _, vid = np.unique(verts.view(np.dtype((np.void, 12))).ravel(), return_inverse=True)
-    vid = vid.reshape(count, 3)
+    vid = _vertex_ids(tri)
     edges = np.sort(np.stack([vid[:, [0, 1]], vid[:, [1, 2]], vid[:, [2, 0]]], axis=1), axis=2).reshape(-1, 2)
     owner = np.repeat(np.arange(count), 3)
     key = edges[:, 0].astype(np.int64) * (int(vid.max()) + 1) + edges[:, 1]
@@ -87,9 +93,7 @@ def outward(tri: np.ndarray) -> np.ndarray:
     count = len(tri)
     if count == 0:
         return tri
-    verts = np.ascontiguousarray(tri.reshape(-1, 3).astype(np.float32))
-    _, vid = np.unique(verts.view(np.dtype((np.void, 12))).ravel(), return_inverse=True)
-    vid = vid.reshape(count, 3)
+    vid = _vertex_ids(tri)
     a, b = vid.reshape(-1), vid[:, [1, 2, 0]].reshape(-1)  # directed edges, three per triangle
     key = np.minimum(a, b).astype(np.int64) * (int(vid.max()) + 1) + np.maximum(a, b)
     order = np.argsort(key, kind="stable")

@@ -95,9 +95,11 @@ vec3 polygon_light_solid_angle(GpuLight L, vec3 p, vec3 n) {
         vec3 tn = cross(b - a, c - a);
         float len = length(tn);
         float height = -dot(a, tn) / max(len, 1e-30);   // p above the triangle's plane, along its winding normal
-        vec3 edges = vec3(dot(cross(b - a, -a), tn), dot(cross(c - b, -b), tn), dot(cross(a - c, -c), tn));
-        bool over = min(edges.x, min(edges.y, edges.z)) > 1e-3 * len * len;   // barycentrics > 1e-3
-        if ((over && abs(height) <= SELF_PLANE * sqrt(0.5 * len)) || (scale.w > 0.5 && height < 0.0)) continue;
+        if (scale.w > 0.5 && height < 0.0) continue;   // behind a one-sided triangle
+        if (abs(height) <= SELF_PLANE * sqrt(0.5 * len)) {   // on its plane: on it, if over it (barycentrics > 1e-3)
+            vec3 edges = vec3(dot(cross(b - a, -a), tn), dot(cross(c - b, -b), tn), dot(cross(a - c, -c), tn));
+            if (min(edges.x, min(edges.y, edges.z)) > 1e-3 * len * len) continue;
+        }
         sum += triangle_projected_solid_angle(a, b, c, n) * scale.rgb;
     }
     return sum;
