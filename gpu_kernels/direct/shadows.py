@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from ..common import atlas
 from ..common import lights as lb
 from ..gl.bind import set_uniform, ssbo, write_uniform
 from ..scene import Scene, hash_parts
@@ -51,7 +52,7 @@ def render_shadow_atlas(ctx, programs, scene: Scene, geometry: GeometryBuffers,
     depth. None: rendered here, and the atlas owns it."""
     buffers = lb.build_light_buffers(scene, settings, trapping)
     max_size = ctx.info.get("GL_MAX_TEXTURE_SIZE", 16384)
-    tiles, size, scale = lb.allocate_atlas([v.resolution for v in buffers.views], max_height=max_size)
+    tiles, size, scale = atlas.allocate_atlas([v.resolution for v in buffers.views], max_height=max_size)
     warnings = list(buffers.warnings)
     if scale > 1:
         warnings.append(f"shadow maps reduced {scale}x to fit the atlas ({len(buffers.views)} views)")
@@ -61,7 +62,7 @@ def render_shadow_atlas(ctx, programs, scene: Scene, geometry: GeometryBuffers,
 
     key = depth_key(buffers.views, tiles, size)
     depth = render() if depth_pass is None else depth_pass(key, render)
-    views = lb.pack_views(buffers.views, tiles, size, settings.pcf_radius, buffers.view_lights)
+    views = atlas.pack_views(buffers.views, tiles, size, settings.pcf_radius, buffers.view_lights)
     return ShadowAtlas(depth, size, ssbo(ctx, buffers.lights), ssbo(ctx, views), ssbo(ctx, buffers.polygon_vertices),
                        len(buffers.lights), len(buffers.views), warnings, buffers, owns_depth=depth_pass is None,
                        views_key=views_key(buffers, key, views))

@@ -8,6 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..common import atlas
 from ..common import lights as lb
 from ..direct.geometry import draw_by_material
 from ..gl.bind import set_uniform, ssbo, write_uniform
@@ -87,7 +88,7 @@ def render_rsm(ctx, programs, scene: Scene, geometry, textures, shadows, resolut
     views, view_lights = buffers.views, buffers.view_lights
     res = [view_resolution(resolution, v.ortho, int(buffers.lights[light]["params"][2]), 2 * v.half_extent, texel)
            for v, light in zip(views, view_lights)]
-    tiles, size, scale = lb.allocate_atlas(res, max_height=ctx.info.get("GL_MAX_TEXTURE_SIZE", 16384))
+    tiles, size, scale = atlas.allocate_atlas(res, max_height=ctx.info.get("GL_MAX_TEXTURE_SIZE", 16384))
     targets = [ctx.texture(size, 4, dtype="f4") for _ in range(3)]
     for t in targets:
         t.filter = (moderngl.NEAREST, moderngl.NEAREST)

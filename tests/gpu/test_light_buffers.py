@@ -7,6 +7,7 @@ import re
 import numpy as np
 import pytest
 
+from bounce_gi.gpu_kernels.common import atlas
 from bounce_gi.gpu_kernels.common import lights as lb
 from bounce_gi.gpu_kernels.gl import preprocessor as spp
 from bounce_gi.gpu_kernels.lpv.gather import VPL_DTYPE
@@ -115,7 +116,7 @@ def test_gpu_reads_numpy_records_field_for_field(gl_context, tmp_path):
                            far=3.0 + i) for i in range(2)]
     views[1].emit_normal, views[1].emit_share = np.array([0.0, 0.6, -0.8]), 0.25  # a polygon-light sample
     tiles = [(0, 0, 256, 256), (256, 0, 256, 256)]  # tiles at the views' own resolution (atlas not scaled)
-    packed = lb.pack_views(views, tiles, (512, 256), pcf_radius=2)
+    packed = atlas.pack_views(views, tiles, (512, 256), pcf_radius=2)
     polygon = rng.uniform(-1, 1, (5, 4)).astype(np.float32)
 
     src = tmp_path / "readback.glsl"
@@ -233,7 +234,7 @@ def _check_tiles(tiles, size, expected_res):
     [512, 16, 300, 1000, 77, 2048, 256, 256, 3000],
 ])
 def test_atlas_tiles_inside_and_disjoint(resolutions):
-    tiles, size, scale = lb.allocate_atlas(resolutions)
+    tiles, size, scale = atlas.allocate_atlas(resolutions)
     assert scale == 1
     _check_tiles(tiles, size, resolutions)
     # Packing must not be absurdly wasteful: the tiles cover at least a third of the atlas.
@@ -242,11 +243,11 @@ def test_atlas_tiles_inside_and_disjoint(resolutions):
 
 def test_atlas_scales_down_when_max_height_is_small():
     resolutions = [2048] * 8 + [512] * 6  # at 4096 wide this needs 4 rows of 2048 = 8192 texels of height
-    tiles, size, scale = lb.allocate_atlas(resolutions, width=4096, max_height=4096)
+    tiles, size, scale = atlas.allocate_atlas(resolutions, width=4096, max_height=4096)
     assert scale == 2  # halving once fits: 8 × 1024² + 6 × 256² in 4096 × ≤ 4096
     assert size[1] <= 4096
     _check_tiles(tiles, size, [r // 2 for r in resolutions])
-    tiles, size, scale = lb.allocate_atlas(resolutions, width=4096, max_height=1024)
+    tiles, size, scale = atlas.allocate_atlas(resolutions, width=4096, max_height=1024)
     # 4× would fit (8 × 512 in one 4096-wide row, 6 × 128 below: 640 high), but the packer first picks a
     # square-ish 2048-wide atlas and then halves again, so it returns 8× (suboptimal, not wrong; see report).
     assert scale in (4, 8) and size[1] <= 1024
@@ -254,7 +255,7 @@ def test_atlas_scales_down_when_max_height_is_small():
 
 
 def test_atlas_tile_wider_than_atlas_width_is_scaled_to_fit():
-    tiles, size, scale = lb.allocate_atlas([8192, 512], width=4096, max_height=16384)
+    tiles, size, scale = atlas.allocate_atlas([8192, 512], width=4096, max_height=16384)
     _check_tiles(tiles, size, [8192 // scale, max(16, 512 // scale)])
 
 
@@ -354,7 +355,7 @@ def test_point_light_views_cover_every_direction():
 def test_packed_texel_size_follows_the_tile_actually_allocated():
     views = lb.cube_views(np.zeros(3), 512, 0.01, 10.0)[:2]
     tiles = [(0, 0, 256, 256), (256, 0, 256, 256)]  # what allocate_atlas returns at scale 2
-    packed = lb.pack_views(views, tiles, (512, 256), pcf_radius=1)
+    packed = atlas.pack_views(views, tiles, (512, 256), pcf_radius=1)
     # The views were made for 512 texels; packed into 256-texel tiles, each texel covers twice the world size.
     for v, rec in zip(views, packed):
         assert rec["info"][0] == pytest.approx(v.texel_world * 512 / 256, rel=1e-6)

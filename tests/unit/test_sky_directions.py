@@ -6,6 +6,7 @@ import math
 import numpy as np
 
 from bounce_gi.gpu_kernels.common import camera as cam
+from bounce_gi.gpu_kernels.common import atlas
 from bounce_gi.gpu_kernels.common import lights as lb
 from bounce_gi.gpu_kernels.scene import Material
 from support.synthetic import box_quads, quad_scene
@@ -39,7 +40,7 @@ def test_a_lit_world_is_one_sky_light_with_a_view_per_direction():
     assert len(views) == rec["params"][2] == 64 and rec["params"][3] == 1
     assert all(v.ortho and v.resolution == 128 and v.pcf_radius == 0 for v in views)
     assert abs(sum(v.emit_share for v in views) - 4 * math.pi) < 1e-9
-    packed = lb.pack_views(buffers.views, [(0, 0, 128, 128)] * len(buffers.views), (4096, 4096), 1,
+    packed = atlas.pack_views(buffers.views, [(0, 0, 128, 128)] * len(buffers.views), (4096, 4096), 1,
                            buffers.view_lights)
     assert (packed["info"][:, 1] == 0).all()  # the sky's maps: no PCF (direct/eval.glsl reads 4 texels' min)
     assert not any(int(r["color_type"][3]) == lb.LIGHT_SKY
