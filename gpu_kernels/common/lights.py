@@ -52,9 +52,10 @@ class ShadowSettings:
     spot_resolution: int = 1024
     cube_resolution: int = 512  # per face, point lights
     area_cube_resolution: int = 384  # per face at an area light's sample points (its soft shadows are read there)
-    sample_cube_resolution: int = 256  # per face at an emitter's sample points
+    sample_cube_resolution: int = 256  # per face at an emitter's sample points, at most (emitter_cube_resolution)
     area_samples: int = 2  # n×n shadow sample points on square/rectangle lights (n² ring points on disks)
-    emissive_sample_budget: int = 64  # cubes for all emitters: ≤ budget/2 clusters (common/emitters.py)
+    emissive_sample_budget: int = 256  # cubes for all emitters: ≤ budget/2 clusters (common/emitters.py)
+    emissive_texels: int = 64 * 6 * 256 ** 2  # all emitter cubes' texels: more cubes get smaller faces
     pcf_radius: int = 1  # PCF kernel (2r+1)²
     # The world's light: shadow directions over the sphere (0: unshadowed; a quadrature, its bands smoothed by
     # direct/sky_filter.glsl) and texels per side of each one's map (benchmarks/results/llvmpipe/sky.md: the sweep).
@@ -343,10 +344,22 @@ def _add_emissive(out: _Records, scene: Scene, s: ShadowSettings, trapping: list
     """Every emissive triangle, in ≤ emissive_sample_budget/2 two-sided polygon lights (common/emitters.py), each
     shadowed from its sample points on both sides of the surface (not the trapped inner side of a closed one)."""
     half = max(1, s.emissive_sample_budget // 2)
-    for c in em.cluster_emitters(scene, half, half, trapping):
+    clusters = [(c, [x for x in em.side_samples(c) if not x[3]])
+                for c in em.cluster_emitters(scene, half, half, trapping)]
+    resolution = emitter_cube_resolution(sum(len(samples) for _, samples in clusters), s)
+    for c, samples in clusters:
         color = c.radiance.max(axis=0)
-        v, samples = [], [sample for sample in em.side_samples(c) if not sample[3]]
+        v = []
         for point, normal, share, _ in samples:
-            v.extend(cube_views(point, s.sample_cube_resolution, *_near_far(scene, point), normal, share / c.area))
+            v.extend(cube_views(point, resolution, *_near_far(scene, point), normal, share / c.area))
         out.add(LIGHT_POLYGON, color, c.centroid, 0.0, c.normal, light_views=v, samples=len(samples), per=6,
                 poly=triangle_list_vertices(c.vertices, c.radiance, color, c.one_sided), two_sided=True)
+
+
+def emitter_cube_resolution(cubes: int, s: ShadowSettings) -> int:
+    """Texels per side of each emitter cube's faces: sample_cube_resolution, or less (a multiple of 16) where the
+    scene's `cubes` would outgrow emissive_texels together: on the emitters measured, more sample points at coarser
+    faces shadowed better than fewer at finer ones (benchmarks/results/llvmpipe/emitters.md), and an atlas past its
+    size would halve every light's maps (common/atlas.py)."""
+    fit = int(math.sqrt(s.emissive_texels / (6 * max(cubes, 1)))) // 16 * 16
+    return max(16, min(s.sample_cube_resolution, fit))

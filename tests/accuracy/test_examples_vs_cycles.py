@@ -98,6 +98,10 @@ from examples import references  # noqa: E402
 # -> 0.024, LPV Diffuse Indirect 0.098 -> 0.066 (1.08 -> 0.98 of Cycles'), Combined 0.055 -> 0.048 (VCT 0.052 ->
 # 0.052); worse: LPV Glossy Indirect 0.295 -> 0.323, VCT 0.246 -> 0.251. furnished within 0.001 (Diffuse Direct
 # 0.0154 -> 0.016). The other scenes have no closed emitter and did not move.
+# 2026-12-06 (stop 39): lamp_room and furnished re-measured with 256 emitter cubes instead of 64, their faces shrunk
+# to share 64 cubes' texels (common/lights.emitter_cube_resolution: 128² each here). lamp_room LPV / VCT: Diffuse
+# Direct 0.023 -> 0.017 (the target met), Combined 0.048 -> 0.045 / 0.052 -> 0.047, VCT Diffuse Indirect 0.083 ->
+# 0.080; furnished within 0.002 (Diffuse Direct 0.016 both). The other scenes have no emissive mesh.
 BOUNDS = {
     'default_principled': {
         'lpv': {'Combined': 0.050, 'Diffuse Direct': 0.008, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.010, 'Glossy Indirect': 0.530, 'Glossy Color': 0.020, 'Diffuse Light': 0.046, 'Diffuse Color match': 0.998},
@@ -124,8 +128,8 @@ BOUNDS = {
         'vct': {'Combined': 0.071, 'Diffuse Direct': 0.096, 'Diffuse Indirect': 0.079, 'Diffuse Color': 0.002, 'Glossy Direct': 0.235, 'Glossy Indirect': 0.247, 'Glossy Color': 0.025, 'Diffuse Light': 0.071, 'Diffuse Color match': 0.998},
     },
     'lamp_room': {
-        'lpv': {'Combined': 0.080, 'Diffuse Direct': 0.038, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.002, 'Glossy Direct': 0.033, 'Glossy Indirect': 0.461, 'Glossy Color': 0.017, 'Emission': 0.002, 'Diffuse Light': 0.123, 'Diffuse Color match': 0.998},
-        'vct': {'Combined': 0.080, 'Diffuse Direct': 0.038, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.002, 'Glossy Direct': 0.033, 'Glossy Indirect': 0.389, 'Glossy Color': 0.017, 'Emission': 0.002, 'Diffuse Light': 0.135, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.080, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.002, 'Glossy Direct': 0.033, 'Glossy Indirect': 0.459, 'Glossy Color': 0.017, 'Emission': 0.002, 'Diffuse Light': 0.121, 'Diffuse Color match': 0.998},
+        'vct': {'Combined': 0.080, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.002, 'Glossy Direct': 0.033, 'Glossy Indirect': 0.383, 'Glossy Color': 0.017, 'Emission': 0.002, 'Diffuse Light': 0.130, 'Diffuse Color match': 0.998},
     },
     'many_lights': {
         'lpv': {'Combined': 0.072, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.108, 'Diffuse Color': 0.004, 'Glossy Direct': 0.057, 'Glossy Indirect': 0.214, 'Glossy Color': 0.032, 'Diffuse Light': 0.074, 'Diffuse Color match': 0.998},
@@ -140,8 +144,8 @@ BOUNDS = {
         'vct': {'Combined': 0.041, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.034, 'Glossy Indirect': 0.490, 'Glossy Color': 0.016, 'Diffuse Light': 0.039, 'Diffuse Color match': 0.996},
     },
     'furnished': {
-        'lpv': {'Combined': 0.080, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.036, 'Glossy Indirect': 0.255, 'Glossy Color': 0.025, 'Emission': 0.009, 'Diffuse Light': 0.091, 'Diffuse Color match': 0.998},
-        'vct': {'Combined': 0.078, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.140, 'Diffuse Color': 0.003, 'Glossy Direct': 0.036, 'Glossy Indirect': 0.236, 'Glossy Color': 0.025, 'Emission': 0.009, 'Diffuse Light': 0.080, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.080, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.035, 'Glossy Indirect': 0.254, 'Glossy Color': 0.025, 'Emission': 0.009, 'Diffuse Light': 0.089, 'Diffuse Color match': 0.998},
+        'vct': {'Combined': 0.076, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.138, 'Diffuse Color': 0.003, 'Glossy Direct': 0.035, 'Glossy Indirect': 0.235, 'Glossy Color': 0.025, 'Emission': 0.009, 'Diffuse Light': 0.078, 'Diffuse Color match': 0.998},
     },
     'cornell_animated': {
         'lpv': {'Combined': 0.044, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.089, 'Diffuse Color': 0.002, 'Diffuse Light': 0.043, 'Diffuse Color match': 0.999},

@@ -234,3 +234,17 @@ def test_a_closed_emitter_emits_outwards_only_and_creates_no_trapped_cubes():
     open_ = scene_of((cylinder(caps=False), lamp()), (floor(), Material("floor")))
     assert not any(c.one_sided.any() for c in em.cluster_emitters(open_, 32, 32))
 
+
+@pytest.mark.parametrize("case", ["one quad", "lamp shade (92)", "100 coloured quads"])
+def test_emitter_cubes_share_a_fixed_texel_budget(case):
+    """Few cubes keep sample_cube_resolution; many get smaller faces, so that all of them together stay within
+    ShadowSettings.emissive_texels and never push the atlas past its size (which halves every light's maps)."""
+    s = lb.ShadowSettings()
+    buffers = lb.build_light_buffers(CASES[case](), s)
+    texels = sum(v.resolution ** 2 for v in buffers.views)
+    assert texels <= s.emissive_texels
+    assert all(v.resolution % 16 == 0 for v in buffers.views)
+    if len(buffers.views) * s.sample_cube_resolution ** 2 <= s.emissive_texels:
+        assert {v.resolution for v in buffers.views} == {s.sample_cube_resolution}
+    else:  # as fine as the budget allows: the next multiple of 16 would outgrow it
+        assert len(buffers.views) * (buffers.views[0].resolution + 16) ** 2 > s.emissive_texels
