@@ -80,19 +80,28 @@ def perspective(fov_y: float, aspect: float, n: float, f: float) -> np.ndarray:
     return frustum(-t * aspect, t * aspect, -t, t, n, f)
 
 
+def _cross(a, b) -> tuple:
+    """a × b of two 3-vectors, in plain floats: np.cross costs tens of microseconds a call, and the shadow views
+    of a scene's lights take thousands of these (six per emitter or area-light sample, one per sky direction)."""
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+def _unit(v) -> tuple:
+    n = math.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
+    return (v[0] / n, v[1] / n, v[2] / n)
+
+
 def look_at(eye, target, up) -> np.ndarray:
     """World → view matrix looking from `eye` at `target` (float64)."""
-    eye, target, up = (np.asarray(v, np.float64) for v in (eye, target, up))
-    fwd = target - eye
-    fwd /= np.linalg.norm(fwd)
-    side = np.cross(fwd, up)
-    if np.linalg.norm(side) < 1e-8:  # looking along `up`: pick another up
-        side = np.cross(fwd, np.array([1.0, 0, 0]) if abs(fwd[0]) < 0.9 else np.array([0, 1.0, 0]))
-    side /= np.linalg.norm(side)
-    upv = np.cross(side, fwd)
+    eye, target, up = ([float(c) for c in v] for v in (eye, target, up))
+    fwd = _unit([t - e for t, e in zip(target, eye)])
+    side = _cross(fwd, up)
+    if math.sqrt(sum(c * c for c in side)) < 1e-8:  # looking along `up`: pick another up
+        side = _cross(fwd, (1.0, 0.0, 0.0) if abs(fwd[0]) < 0.9 else (0.0, 1.0, 0.0))
+    side = _unit(side)
     m = np.eye(4)
-    m[0, :3], m[1, :3], m[2, :3] = side, upv, -fwd
-    m[:3, 3] = -m[:3, :3] @ eye
+    m[0, :3], m[1, :3], m[2, :3] = side, _cross(side, fwd), [-c for c in fwd]
+    m[:3, 3] = -m[:3, :3] @ np.asarray(eye)
     return m
 
 
