@@ -10,7 +10,8 @@ Passes and their inputs (a pass re-runs only when one of its inputs changed — 
       shadow_depth← geometry, the shadow views (their depth atlas: a light's power or the world's colour
                     moves no view, so it is kept)
     gbuffer       ← geometry, materials, camera, resolution
-    sky_visibility← gbuffer, the shadow views (the sky light's visible shares: a world colour edit keeps them)
+    sky_visibility← gbuffer, the sky's shadow views (its visible shares: a world colour edit or another
+                    light's move keeps them)
     direct_light  ← gbuffer, shadow_maps, sky_visibility
     <method>      ← the above (lpv/passes.py, vct/passes.py: the indirect light)
     compose       ← everything above, world      (CPU: passes as numpy, Combined)
@@ -218,8 +219,9 @@ class Pipeline:
 
     def _direct_light(self, frame, material_lut) -> dict:
         """The direct_light pass, and before it the sky light's visibility, kept apart (sky_visibility): it depends
-        on the G-buffer and the shadow maps, not on any light's colour, so a world or light colour edit skips it."""
-        sky = self.cache.run("sky_visibility", (frame.keys["gbuffer"], frame.shadows.views_key),
+        on the G-buffer and the sky's own shadow maps, not on any light's colour nor on the other lights, so a world
+        or light colour edit and another light's move skip it."""
+        sky = self.cache.run("sky_visibility", (frame.keys["gbuffer"], sh.sky_key(frame.shadows)),
                              lambda: lighting.render_sky_visibility(self.ctx, self.programs, frame.gbuffer,
                                                                     frame.shadows, material_lut))
         return self.cache.run("direct_light", frame.keys["direct"], lambda: lighting.render_direct_light(
@@ -251,10 +253,12 @@ class Pipeline:
         keys["shadow"] = (keys["geometry"], keys["materials"], keys["lights"], keys["world"], repr(settings.shadow),
                          around)
         # The depth atlas is a pass of its own, keyed by the views it draws: a light's power or colour and the
-        # world's change the records, not the maps (384 of them for the sky).
+        # world's change the records, not the maps (576 of them for the sky). A light's move redraws its own maps
+        # into the kept atlas (direct/shadows.render_depth), not every light's.
         shadows = cache.run("shadow_maps", keys["shadow"], lambda: sh.render_shadow_atlas(
             ctx, programs, scene, geometry, settings.shadow, trapping,
-            depth_pass=lambda key, render: cache.run("shadow_depth", (keys["geometry"], key), render)))
+            depth_pass=lambda key, render: cache.run("shadow_depth", (keys["geometry"], key), lambda: render(
+                next((v for k, v in cache.kept("shadow_depth") if k[0] == keys["geometry"]), None)))))
         keys["gbuffer"] = (keys["geometry"], keys["materials"], keys["camera"])
         if samples is None:
             gbuffer = cache.run("gbuffer", keys["gbuffer"], lambda: gb.render_gbuffer(

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
+
 from ..common import atlas
 from ..common import lights as lb
 from ..gl.bind import set_uniform, ssbo, write_uniform
@@ -25,6 +27,7 @@ class ShadowAtlas:
     buffers: lb.LightBuffers  # the CPU-side records (RSMs reuse the views)
     owns_depth: bool = True  # False where the depth atlas is cached apart (render_shadow_atlas's depth_pass)
     views_key: str = ""  # views_key: what the maps and records are besides the lights' colours
+    light_keys: list = None  # light_signatures: the same, per light
     _raw: object = None
 
     def raw_depth(self):
@@ -49,7 +52,8 @@ def render_shadow_atlas(ctx, programs, scene: Scene, geometry: GeometryBuffers,
     `trapping`: the closed emitters whose inner light is trapped (common/emitters.trapping_shells).
     `depth_pass(key, render)`: where the depth atlas is cached apart (the pipeline's 'shadow_depth' pass), keyed by
     `depth_key` of the views; a light's power or colour, or the world's, moves no view, so such an edit renders no
-    depth. None: rendered here, and the atlas owns it."""
+    depth. It calls render(prior), prior a DepthAtlas of the same geometry or None (render_depth). None: rendered
+    here, and the atlas owns it."""
     buffers = lb.build_light_buffers(scene, settings, trapping)
     max_size = ctx.info.get("GL_MAX_TEXTURE_SIZE", 16384)
     tiles, size, scale = atlas.allocate_atlas([v.resolution for v in buffers.views], max_height=max_size)
@@ -57,15 +61,35 @@ def render_shadow_atlas(ctx, programs, scene: Scene, geometry: GeometryBuffers,
     if scale > 1:
         warnings.append(f"shadow maps reduced {scale}x to fit the atlas ({len(buffers.views)} views)")
 
-    def render():
-        return render_depth(ctx, programs, geometry, buffers.views, tiles, size)
+    def render(prior=None):
+        return render_depth(ctx, programs, geometry, buffers.views, tiles, size, prior)
 
     key = depth_key(buffers.views, tiles, size)
-    depth = render() if depth_pass is None else depth_pass(key, render)
+    depth = (render() if depth_pass is None else depth_pass(key, render)).texture
     views = atlas.pack_views(buffers.views, tiles, size, settings.pcf_radius, buffers.view_lights)
     return ShadowAtlas(depth, size, ssbo(ctx, buffers.lights), ssbo(ctx, views), ssbo(ctx, buffers.polygon_vertices),
                        len(buffers.lights), len(buffers.views), warnings, buffers, owns_depth=depth_pass is None,
-                       views_key=views_key(buffers, key, views))
+                       views_key=views_key(buffers, key, views), light_keys=light_signatures(buffers))
+
+
+def light_signatures(buffers: lb.LightBuffers) -> list:
+    """Per light, a key of what its shadow maps and its light are made from besides its colour: its record (colour
+    left out), its polygon and its views. An edit that leaves a light's key leaves whatever was made from that
+    light alone: the sky's visibility (pipeline.py), a light's first bounce (lpv/passes.first_bounce)."""
+    rows, owner = view_rows(buffers.views), np.asarray(buffers.view_lights or [], np.int64)
+    out = []
+    for i, rec in enumerate(buffers.lights):
+        rec = rec.copy()
+        rec["color_type"][:3] = 0.0
+        first, count = int(rec["polygon"][0]), int(rec["polygon"][1])
+        out.append(hash_parts(rec, buffers.polygon_vertices[first:first + count], rows[owner == i]))
+    return out
+
+
+def sky_key(shadows: ShadowAtlas) -> tuple:
+    """The sky lights' keys (light_signatures): what the sky's visibility is made from besides the G-buffer."""
+    kinds = shadows.buffers.lights["color_type"][:, 3] if len(shadows.buffers.lights) else []
+    return tuple(k for k, kind in zip(shadows.light_keys, kinds) if int(kind) == lb.LIGHT_SKY)
 
 
 def views_key(buffers: lb.LightBuffers, depth: str, packed) -> str:
@@ -84,26 +108,62 @@ def depth_key(views: list, tiles: list, size: tuple) -> str:
     return hash_parts([(v.view_projection, v.origin, v.far) for v in views], [tuple(t) for t in tiles], tuple(size))
 
 
-def render_depth(ctx, programs, geometry: GeometryBuffers, views: list, tiles: list, size: tuple):
-    """The depth atlas: every view drawn into its tile (direct/shadow_depth.glsl), comparison enabled."""
+@dataclass
+class DepthAtlas:
+    """The depth atlas (comparison enabled) and what each of its tiles holds: `views` (N, 20) rows of a view's
+    projection, eye and depth range (view_rows). A later atlas of the same geometry whose views fill the same tiles
+    redraws only the tiles whose view changed: a light's move redraws that light's maps, not every light's."""
+    texture: object
+    tiles: list
+    size: tuple
+    views: np.ndarray
+    drawn: int = 0  # views drawn when it was last made or updated
+
+    def release(self):
+        self.texture.release()
+
+
+def view_rows(views: list) -> np.ndarray:
+    """(N, 20) float64: each view's projection, eye and depth range — what its depth tile is drawn from."""
+    return np.array([np.concatenate([np.ravel(v.view_projection), np.ravel(v.origin), [v.far]]) for v in views],
+                    np.float64).reshape(len(views), 20)
+
+
+def render_depth(ctx, programs, geometry: GeometryBuffers, views: list, tiles: list, size: tuple,
+                 prior: DepthAtlas | None = None) -> DepthAtlas:
+    """The depth atlas: every view drawn into its tile (direct/shadow_depth.glsl). With `prior` (an atlas of the
+    same geometry, tiled alike) only the views that changed are drawn again, into `prior`, which is returned
+    updated: whoever held it sees the new maps (the pass cache, whose entry it then is)."""
     import moderngl
 
-    depth = ctx.depth_texture(size)
-    depth.compare_func = "<="
-    depth.filter = (moderngl.LINEAR, moderngl.LINEAR)
-    depth.repeat_x = depth.repeat_y = False
-    if views:
+    rows, tiles, size = view_rows(views), [tuple(t) for t in tiles], tuple(size)
+    if prior is not None and prior.tiles == tiles and prior.size == size:
+        depth, redraw = prior.texture, np.nonzero(np.any(rows != prior.views, axis=1))[0].tolist()
+    else:
+        depth, redraw = ctx.depth_texture(size), None
+        depth.compare_func = "<="
+        depth.filter = (moderngl.LINEAR, moderngl.LINEAR)
+        depth.repeat_x = depth.repeat_y = False
+    if views and redraw != []:
         fbo = ctx.framebuffer(depth_attachment=depth)
         fbo.use()
-        fbo.clear(depth=1.0)
+        if redraw is None:
+            fbo.clear(depth=1.0)
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.disable(moderngl.CULL_FACE)
         prog = programs.raster("direct/shadow_depth.glsl")
-        for view, (x, y, w, h) in zip(views, tiles):
-            fbo.viewport = (x, y, w, h)
+        for i in range(len(views)) if redraw is None else redraw:
+            view, tile = views[i], tiles[i]
+            if redraw is not None:
+                fbo.clear(depth=1.0, viewport=tile)
+            fbo.viewport = tile
             write_uniform(prog, "u_view_projection", view.view_projection.T)
             set_uniform(prog, "u_origin", tuple(float(c) for c in view.origin))
             set_uniform(prog, "u_far", float(view.far))
             geometry.vao_depth.render(moderngl.TRIANGLES)
         fbo.release()
-    return depth
+    drawn = len(views) if redraw is None else len(redraw)
+    if redraw is not None:
+        prior.views, prior.drawn = rows, drawn
+        return prior
+    return DepthAtlas(depth, tiles, size, rows, drawn)

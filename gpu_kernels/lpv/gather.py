@@ -24,7 +24,7 @@ import numpy as np
 
 from ..common.bounce_tail import tail_ratio, tail_sum
 from ..common.grid import Grid
-from ..gl.bind import bind_grid, bind_light_records, bind_named, dispatch, set_uniform, zero_texture
+from ..gl.bind import bind_grid, bind_light_records, bind_named, dispatch, set_uniform, ssbo, zero_texture
 from .crossings import bind_visibility
 from .occlusion import absorb
 from .settings import LpvSettings
@@ -113,27 +113,56 @@ def _fitted(ctx, records: np.ndarray, size: float, block: int, budget: int) -> V
 
 
 def rsm_records(ctx, programs, rsm, shadows, grid: Grid, budget: int, limit: int | None = None,
-                unit_color: bool = False) -> tuple[np.ndarray, int]:
+                unit_color: bool = False, lights: np.ndarray | None = None) -> tuple[np.ndarray, int]:
     """The RSM as VPL records (VPL_DTYPE) and k: k×k texel blocks (intensity-aware, lpv/inject.glsl MODE_LIST), k the
     smallest power of two whose blocks number at most `limit` (default a few times `budget`: much of an atlas is
     empty, a sun's map covers the whole grid, a spot's cone a disc). A block spanning two surfaces gives two VPLs;
     the grid's cell sets the plane tolerance. Each record's flux.w is its light's index; with `unit_color` its flux
-    is per unit of that light's colour (the flux a colour of 1 would give)."""
+    is per unit of that light's colour (the flux a colour of 1 would give). `lights` (bool per light): only those
+    lights' texels make records (the same records, in the same order, as without it)."""
     prog = programs.compute("lpv/inject.glsl", {"MODE_LIST": 1})
     bind_grid(prog, grid)
     set_uniform(prog, "u_unit_color", bool(unit_color))
-
-    def cluster(k):
-        blocks = rsm_uniforms(prog, rsm, shadows, k)
-        set_uniform(prog, "u_blocks_x", int(blocks[0]))
-        return _collect(ctx, 2 * blocks[0] * blocks[1],
-                        lambda: dispatch(prog, (blocks[0], blocks[1]), local=8))
-
+    set_uniform(prog, "u_masked", lights is not None)
+    mask = ssbo(ctx, np.asarray([] if lights is None else lights, np.uint32))
+    mask.bind_to_storage_buffer(7)
     k = 1
     limit = PRECLUSTER * budget if limit is None else limit
     while k < MAX_BLOCK and -(-rsm.size[0] // k) * -(-rsm.size[1] // k) > limit:
         k *= 2  # cluster on the GPU first, so that the read-back stays a few times the budget
-    return cluster(k), k
+    blocks = rsm_uniforms(prog, rsm, shadows, k)
+    set_uniform(prog, "u_blocks_x", int(blocks[0]))
+    boxes = [(0, 0, blocks[0], blocks[1])] if lights is None else [
+        (x // k, y // k, -(-w // k), -(-h // k)) for (x, y, w, h), light in zip(rsm.tiles, shadows.buffers.view_lights)
+        if lights[light]]
+    bands = _bands([(y, y + h) for _, y, _, h in boxes])
+    slots = sum(2 * blocks[0] * (y1 - y0) for y0, y1 in bands)
+
+    def run():
+        base = 0
+        for y0, y1 in bands:  # each band of block rows from its own slot on, in the atlas's row order
+            set_uniform(prog, "u_row_base", int(y0))
+            set_uniform(prog, "u_slot_base", int(base))
+            for bx, by, bw, bh in boxes:
+                if y0 <= by < y1:
+                    set_uniform(prog, "u_block_origin", (int(bx), int(by)))
+                    set_uniform(prog, "u_block_count", (int(bw), int(bh)))
+                    dispatch(prog, (bw, bh), local=8)
+            base += 2 * blocks[0] * (y1 - y0)
+    records = _collect(ctx, slots, run)
+    mask.release()
+    return records, k
+
+
+def _bands(spans: list) -> list:
+    """Half-open row ranges [y0, y1) merged where they overlap or touch, in increasing order."""
+    out = []
+    for y0, y1 in sorted(spans):
+        if out and y0 <= out[-1][1]:
+            out[-1] = (out[-1][0], max(out[-1][1], y1))
+        else:
+            out.append((y0, y1))
+    return out
 
 
 def vpl_list(ctx, programs, rsm, shadows, grid: Grid, budget: int) -> VplList:

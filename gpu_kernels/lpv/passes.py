@@ -21,6 +21,8 @@ alone and the passes are instead:
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from ..common.method import MethodOutput
@@ -44,8 +46,10 @@ def run(frame) -> MethodOutput:
     texel = min(g.cell for g in grids) / RSM_TEXELS_PER_CELL
     # The RSMs hold positions, normals and albedo: they follow the lights' views, not their colours.
     k_rsm = (frame.keys["geometry"], frame.keys["materials"], frame.shadows.views_key, s.rsm_resolution, texel)
+    # A light's move redraws its own views into the kept RSM of the same geometry and materials (render_rsm).
+    prior = next((v for k, v in cache.kept("rsm") if k[:2] == k_rsm[:2] and k[3:] == k_rsm[3:]), None)
     maps = cache.run("rsm", k_rsm, lambda: rsm.render_rsm(ctx, programs, scene, frame.geometry, frame.textures,
-                                                           frame.shadows, s.rsm_resolution, texel))
+                                                           frame.shadows, s.rsm_resolution, texel, prior))
     budget = transfer_budget(scene, grids, s)
     if budget:
         return _transfer(frame, grids, k_grids, maps, k_rsm, budget)
@@ -130,10 +134,10 @@ def _transfer(frame, grids, k_grids, maps, k_rsm, budget) -> MethodOutput:
     # Each light's first bounce per unit of its colour, binned once (colour-free key: the RSMs' and the clusters'):
     # a colour, power or world edit only rescales them in the solve.
     k_src = (k_rsm, keys["transfer"])
-    lights = len(frame.shadows.buffers.lights)
-    units = cache.run("lpv_inject", k_src, lambda: [clusters.bin_flux(t.clusters, gather.rsm_records(
-        ctx, programs, maps, frame.shadows, grid, budget, clusters.TEXEL_RECORDS, unit_color=True)[0], t.cells,
-        t.normals, groups=lights, axis=t.axis) for t, grid in zip(transfers, grids)])
+    prior = next((v for k, v in cache.kept("lpv_inject") if k[1] == k_src[1] and k[0][:2] == k_rsm[:2]
+                  and k[0][3:] == k_rsm[3:]), None)
+    units = cache.run("lpv_inject", k_src, lambda: first_bounce(
+        ctx, programs, maps, frame.shadows, transfers, grids, budget, prior)).units
     colours = frame.shadows.buffers.lights["color_type"][:, :3].astype(np.float64)  # (lights, 3)
     k_prop = (k_src, frame.keys["shadow"], keys["albedo_transfer"], keys["gv"], s.max_iterations, s.clamp_negative,
               s.bounces, s.epsilon)
@@ -144,6 +148,38 @@ def _transfer(frame, grids, k_grids, maps, k_rsm, budget) -> MethodOutput:
                          lambda: lighting.lighting(ctx, programs, frame.gbuffer, solved["surfaces"], gvs, s))
     return MethodOutput(indirect, None, k_light, {"cascades": solved["stats"],
                                                   "skipped_work": skipped_work(solved["stats"], s)})
+
+
+@dataclass
+class FirstBounce:
+    """Each light's first bounce per unit of its colour, binned into each cascade's clusters — (first (lights, C,
+    3), lost (lights, 3)) per cascade — and what each light's was made from (direct/shadows.light_signatures)."""
+    units: list
+    signatures: list
+    binned: int = 0  # lights binned when it was made (the others' rows came from the prior)
+
+
+def first_bounce(ctx, programs, maps, shadows, transfers, grids, budget, prior=None) -> FirstBounce:
+    """The RSMs' texels as VPL records (gather.rsm_records) binned per light into the clusters (clusters.bin_flux).
+    With `prior` (made with the same clusters), only the lights whose signature changed are binned again — a light's
+    move costs that light's texels, not every light's — and the others' rows are the prior's (the same numbers: a
+    light's records and their order do not depend on the other lights)."""
+    signatures = shadows.light_keys
+    redo = None
+    if prior is not None and len(prior.signatures) == len(signatures):
+        redo = np.array([a != b for a, b in zip(signatures, prior.signatures)], bool)
+        if not redo.any():
+            return FirstBounce(prior.units, signatures, 0)
+    units = []
+    for k, (t, grid) in enumerate(zip(transfers, grids)):
+        records = gather.rsm_records(ctx, programs, maps, shadows, grid, budget, clusters.TEXEL_RECORDS,
+                                     unit_color=True, lights=redo)[0]
+        first, lost = clusters.bin_flux(t.clusters, records, t.cells, t.normals, groups=len(signatures), axis=t.axis)
+        if redo is not None:
+            first = np.where(redo[:, None, None], first, prior.units[k][0])
+            lost = np.where(redo[:, None], lost, prior.units[k][1])
+        units.append((first, lost))
+    return FirstBounce(units, signatures, len(signatures) if redo is None else int(redo.sum()))
 
 
 def _transfer_geometry(frame, grids, k_grids, budget) -> tuple:

@@ -11,6 +11,7 @@ import numpy as np
 from ..common import atlas
 from ..common import lights as lb
 from ..direct.geometry import draw_by_material
+from ..direct.shadows import view_rows
 from ..gl.bind import set_uniform, ssbo, write_uniform
 from ..scene import Scene
 
@@ -26,6 +27,9 @@ class Rsm:
     vao: object = None
     fbo: object = None
     depth: object = None
+    tiles: list = None  # each view's tile (x, y, w, h)
+    views: np.ndarray = None  # (N, 20) what each tile was drawn from (direct/shadows.view_rows)
+    drawn: int = 0  # views drawn when it was last made or updated
 
     def release(self):
         for obj in (self.position, self.normal, self.albedo, self.views_ssbo, self.fbo, self.depth, self.vao):
@@ -79,9 +83,12 @@ def view_resolution(resolution: int, ortho: bool, samples: int, width: float = 0
     return side
 
 
-def render_rsm(ctx, programs, scene: Scene, geometry, textures, shadows, resolution: int, texel: float = 0.0) -> Rsm:
+def render_rsm(ctx, programs, scene: Scene, geometry, textures, shadows, resolution: int, texel: float = 0.0,
+               prior: Rsm | None = None) -> Rsm:
     """Render every shadow view of every light once more as an RSM (position, normal, albedo) into an atlas.
-    `texel` (m, > 0): the finest texel an orthographic view needs (view_resolution)."""
+    `texel` (m, > 0): the finest texel an orthographic view needs (view_resolution). With `prior` (the RSM of the
+    same geometry and materials) only the views that changed are drawn again, into `prior`, which is returned
+    updated (as direct/shadows.render_depth does with the depth atlas: a light's move redraws its own views)."""
     import moderngl
 
     buffers = shadows.buffers
@@ -89,34 +96,66 @@ def render_rsm(ctx, programs, scene: Scene, geometry, textures, shadows, resolut
     res = [view_resolution(resolution, v.ortho, int(buffers.lights[light]["params"][2]), 2 * v.half_extent, texel)
            for v, light in zip(views, view_lights)]
     tiles, size, scale = atlas.allocate_atlas(res, max_height=ctx.info.get("GL_MAX_TEXTURE_SIZE", 16384))
-    targets = [ctx.texture(size, 4, dtype="f4") for _ in range(3)]
-    for t in targets:
-        t.filter = (moderngl.NEAREST, moderngl.NEAREST)
-    depth = ctx.depth_renderbuffer(size)
-    fbo = ctx.framebuffer(color_attachments=targets, depth_attachment=depth)
-    fbo.use()
-    fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+    tiles, size, rows = [tuple(t) for t in tiles], tuple(size), view_rows(views)
+    if prior is not None and prior.tiles == tiles and prior.size == size:
+        out, redraw = prior, set(np.nonzero(np.any(rows != prior.views, axis=1))[0].tolist())
+    else:
+        out, redraw = _new_rsm(ctx, programs, geometry, size, resolution // scale), None
+    out.fbo.use()
+    if redraw is None:
+        out.fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
     ctx.enable(moderngl.DEPTH_TEST)
     ctx.disable(moderngl.CULL_FACE)
     prog = programs.raster("lpv/rsm.glsl")
-    vao = ctx.vertex_array(prog, [(geometry.vbo, "3f 3f 2f 3f", "in_position", "in_normal", "in_uv", "in_geo_normal")])
     records = np.zeros(len(views), RSM_VIEW_DTYPE)
     for i, (view, (x, y, w, h)) in enumerate(zip(views, tiles)):
-        fbo.viewport = (x, y, w, h)
+        _view_record(records[i], view, view_lights[i], buffers.lights[view_lights[i]], i, w)
+        if redraw is not None and i not in redraw:
+            continue
+        if redraw is not None:
+            out.fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0, viewport=(x, y, w, h))
+        out.fbo.viewport = (x, y, w, h)
         write_uniform(prog, "u_view_projection", view.view_projection.T)
-        right, back = view.view_matrix[0, :3], view.view_matrix[2, :3]  # rows of world → view: right, up, back
+        back = view.view_matrix[2, :3]  # rows of world → view: right, up, back
         set_uniform(prog, "u_origin", tuple(float(c) for c in view.origin))
         set_uniform(prog, "u_forward", tuple(float(c) for c in -back))
         set_uniform(prog, "u_ortho", bool(view.ortho))
         set_uniform(prog, "u_far", 0.0 if view.ortho else float(view.far))
         set_uniform(prog, "u_view_index", float(i))
-        draw_by_material(prog, scene, geometry, textures, vao=vao)
-        light = view_lights[i]
-        rec = buffers.lights[light]
-        k = (i - int(rec["params"][1])) // max(int(rec["params"][3]), 1)
-        records[i]["params"] = (0.0 if view.ortho else view.half_extent,
-                                2 * view.half_extent / w if view.ortho else 0.0, light, k)
-        records[i]["origin"] = (*view.origin, 1.0 if view.ortho else 0.0)
-        records[i]["axis"] = (*-back, float(w))  # w: texels per side of this view
-        records[i]["right"] = (*right, view.own_extent)
-    return Rsm(*targets, ssbo(ctx, records), size, resolution // scale, vao, fbo, depth)
+        draw_by_material(prog, scene, geometry, textures, vao=out.vao)
+    if out.views_ssbo is not None and out.views_ssbo.size == records.nbytes:
+        out.views_ssbo.write(records.tobytes())
+    else:
+        if out.views_ssbo is not None:
+            out.views_ssbo.release()
+        out.views_ssbo = ssbo(ctx, records)
+    out.tiles, out.views, out.drawn = tiles, rows, len(views) if redraw is None else len(redraw)
+    return out
+
+
+def _new_rsm(ctx, programs, geometry, size: tuple, resolution: int) -> Rsm:
+    """An empty RSM atlas of `size` texels: position, normal and albedo targets, a depth buffer, the VAO it is
+    drawn with."""
+    import moderngl
+
+    targets = [ctx.texture(size, 4, dtype="f4") for _ in range(3)]
+    for t in targets:
+        t.filter = (moderngl.NEAREST, moderngl.NEAREST)
+    depth = ctx.depth_renderbuffer(size)
+    fbo = ctx.framebuffer(color_attachments=targets, depth_attachment=depth)
+    prog = programs.raster("lpv/rsm.glsl")
+    vao = ctx.vertex_array(prog, [(geometry.vbo, "3f 3f 2f 3f", "in_position", "in_normal", "in_uv", "in_geo_normal")])
+    return Rsm(*targets, None, size, resolution, vao, fbo, depth)
+
+
+def _view_record(record, view, light: int, light_record, index: int, w: int) -> None:
+    """One view's RSM_VIEW_DTYPE record: its projection's extent, eye, axis and the light (and sample) it
+    belongs to."""
+    right, back = view.view_matrix[0, :3], view.view_matrix[2, :3]  # rows of world → view: right, up, back
+    k = (index - int(light_record["params"][1])) // max(int(light_record["params"][3]), 1)
+    record["params"] = (0.0 if view.ortho else view.half_extent, 2 * view.half_extent / w if view.ortho else 0.0,
+                        light, k)
+    record["origin"] = (*view.origin, 1.0 if view.ortho else 0.0)
+    record["axis"] = (*-back, float(w))  # w: texels per side of this view
+    record["right"] = (*right, view.own_extent)
+

@@ -249,10 +249,10 @@ def test_pipeline_reruns_only_what_changed(engine, settings):
     for name, image in first.passes.items():
         np.testing.assert_array_equal(second.passes[name], image)
 
-    # Move only the light: shadows and lighting re-run; geometry, textures and the G-buffer do not.
+    # Move only the light: shadows and lighting re-run; geometry, textures, G-buffer, sky (there is none) do not.
     moved = make_scene(sun(-50.0), cam1)
     third = engine.render(moved, settings)
-    assert set(third.skipped) == {"geometry", "textures", "emitter_shells", "gbuffer"}
+    assert set(third.skipped) == {"geometry", "textures", "emitter_shells", "gbuffer", "sky_visibility"}
     assert {"shadow_depth", "shadow_maps", "direct_light", "compose"}.isdisjoint(third.skipped)
     check_direct(third.passes, moved.lights[0], -50.0)
     np.testing.assert_array_equal(third.passes["Position"], first.passes["Position"])
@@ -272,7 +272,7 @@ def test_pipeline_reruns_only_what_changed(engine, settings):
     assert set(fifth.skipped) == {"geometry", "textures", "emitter_shells", "gbuffer"}
 
     # Another world colour, and then a brighter sun: the lights' records change, no shadow view does, so the
-    # depth atlas (the sky's 384 maps among them) and the sky's visible shares are kept — and the image is what a
+    # depth atlas (the sky's 576 maps among them) and the sky's visible shares are kept — and the image is what a
     # cold render gives.
     kept = {"geometry", "textures", "emitter_shells", "shadow_depth", "gbuffer", "sky_visibility"}
     recoloured = make_scene(sun(-50.0), cam2)

@@ -31,6 +31,16 @@ layout(std430, binding = 3) readonly buffer RsmViewBuffer { RsmView rsm_views[];
 #include "common/structs.glsl"
 layout(std430, binding = 6) writeonly buffer VplList { Vpl vpls[]; };
 uniform int u_blocks_x;           // blocks per atlas row: the list slot of a block
+// One dispatch covers u_block_count blocks from u_block_origin, and writes the rows of blocks from u_row_base on
+// from slot u_slot_base (lpv/gather.rsm_records: the whole atlas, or the rows of the views a light edit moved).
+uniform ivec2 u_block_origin;
+uniform ivec2 u_block_count;
+uniform int u_row_base;
+uniform int u_slot_base;
+// u_masked: only the lights whose light_mask is non-zero make VPLs (a light edit re-bins the lights it moved,
+// lpv/passes.py first_bounce); a block's texels all belong to one view, so one test per block.
+uniform bool u_masked;
+layout(std430, binding = 7) readonly buffer LightMask { uint light_mask[]; };
 #endif
 // The flux per unit of each light's colour (colour × power or strength = 1), its light's index in the record's
 // flux.w (MODE_LIST): the LPV's cached transport bins each light's records once and scales them by its colour.
@@ -112,7 +122,12 @@ void main() {
     // mean would float in the air between them, so texels off the plane of the block's first lit texel (normal
     // more than ~25° away, or more than half a cell from its plane) form a second VPL. Blocks never straddle views:
     // tiles are multiples of 16 texels and k divides 16.
+#if defined(MODE_LIST)
+    if (any(greaterThanEqual(ivec2(gl_GlobalInvocationID.xy), u_block_count))) return;
+    ivec2 block = ivec2(gl_GlobalInvocationID.xy) + u_block_origin;
+#else
     ivec2 block = ivec2(gl_GlobalInvocationID.xy);
+#endif
     if (any(greaterThanEqual(block * u_downsample, u_rsm_size))) return;
     vec3 flux[2] = vec3[2](vec3(0.0), vec3(0.0));
     vec3 position[2] = vec3[2](vec3(0.0), vec3(0.0));
@@ -132,6 +147,9 @@ void main() {
                 plane_p = pos.xyz;
                 plane_n = n;
                 light = rsm_views[int(pos.w - 0.5)].params.z;
+#if defined(MODE_LIST)
+                if (u_masked && light_mask[int(light + 0.5)] == 0u) return;
+#endif
             }
             int c = (dot(n, plane_n) > 0.9 && abs(dot(pos.xyz - plane_p, plane_n)) < 0.5 * u_grid_cell) ? 0 : 1;
             vec3 f = vpl_flux(rsm_views[int(pos.w - 0.5)], pos.xyz, n, texelFetch(u_rsm_albedo, px, 0).rgb);
@@ -144,7 +162,7 @@ void main() {
     for (int c = 0; c < 2; ++c) {
         if (weight[c] <= 0.0 || dot(normal[c], normal[c]) == 0.0) continue;
 #if defined(MODE_LIST)
-        vpls[2 * (block.y * u_blocks_x + block.x) + c] = Vpl(vec4(position[c] / weight[c], 1.0),
+        vpls[u_slot_base + 2 * ((block.y - u_row_base) * u_blocks_x + block.x) + c] = Vpl(vec4(position[c] / weight[c], 1.0),
                                                               vec4(normalize(normal[c]), 0.0), vec4(flux[c], light));
 #else
         inject_lambertian(LpvGrid(u_grid_origin, u_grid_cell, u_grid_size), position[c] / weight[c],

@@ -1,0 +1,72 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""A light's edit redoes that light's work only: its shadow maps (direct/shadows.render_depth), its RSM views
+(lpv/rsm.render_rsm) and its first bounce (lpv/passes.first_bounce) are redrawn and re-binned into what the other
+lights kept, and the sky's visibility is kept when another light moves — and every pass is still exactly what a
+cold render of the edited scene gives."""
+import numpy as np
+import pytest
+
+from bounce_gi.gpu_kernels.common.lights import ShadowSettings
+from bounce_gi.gpu_kernels.scene import Light, Material
+from support.synthetic import box_quads, quad, quad_scene
+
+PASSES = ("Diffuse Direct", "Diffuse Indirect", "Glossy Direct", "Combined")
+
+
+def point(name, x, y, z, power=40.0):
+    m = np.eye(4)
+    m[:3, 3] = (x, y, z)
+    return Light(name, "POINT", (1.0, 0.9, 0.8), power, m)
+
+
+def scene(lights):
+    """A floor and a box under two point lights and a grey sky."""
+    floor = quad([(-5, -5, 0), (5, -5, 0), (5, 5, 0), (-5, 5, 0)], (0, 0, 1))
+    quads = [(floor, 0)] + box_quads((-0.5, -0.5, 0.0), (0.5, 0.5, 1.0), 1, inward=False)
+    s = quad_scene(quads, [Material("floor", (0.6, 0.6, 0.6)), Material("box", (0.8, 0.3, 0.2))], lights,
+                   eye=(0.0, -7.0, 6.0), target=(0.0, 0.0, 0.0), world=(0.2, 0.2, 0.2))
+    s.resolution = (96, 72)
+    return s
+
+
+@pytest.fixture(scope="module")
+def engines():
+    from bounce_gi.gpu_kernels.engine import Engine
+    from bounce_gi.gpu_kernels.gl.context import GpuUnavailableError
+
+    warm, cold = Engine(), Engine()
+    try:
+        warm.gl_info()
+    except GpuUnavailableError as exc:
+        warm.shutdown()
+        cold.shutdown()
+        pytest.skip(str(exc))
+    yield warm, cold
+    warm.shutdown()
+    cold.shutdown()
+
+
+def test_moving_one_light_redraws_only_its_work_and_matches_a_cold_render(engines):
+    from bounce_gi.gpu_kernels.settings import RenderSettings
+
+    warm, cold = engines
+    settings = RenderSettings(method="lpv", width=96, height=72, shadow=ShadowSettings(
+        cube_resolution=128, sky_directions=64, sky_resolution=64))
+    lights = [point("a", -2.0, -1.0, 3.0), point("b", 2.0, 1.5, 2.5)]
+    warm.render(scene(lights), settings)
+    entries = warm.pipeline.cache.entries
+    views = entries["shadow_depth"].value.drawn
+    assert views == 6 + 6 + 64 and entries["rsm"].value.drawn == views  # two cubes and the sky's maps
+    assert entries["lpv_inject"].value.binned == 3
+    for moved in (0, 1):
+        lights[moved] = point(lights[moved].name, lights[moved].matrix_world[0, 3] + 0.3, 0.2, 2.8)
+        edited = scene(lights)
+        result = warm.render(edited, settings)
+        assert entries["shadow_depth"].value.drawn == 6  # the moved light's cube only
+        assert entries["rsm"].value.drawn == 6
+        assert entries["lpv_inject"].value.binned == 1
+        assert "sky_visibility" in result.skipped
+        fresh = cold.render(edited, settings)
+        cold.clear_cache()
+        for name in PASSES:
+            np.testing.assert_array_equal(result.passes[name], fresh.passes[name], err_msg=name)
