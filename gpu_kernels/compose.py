@@ -29,8 +29,8 @@ def compose_passes(gbuffer, direct: dict, world_color, indirect: np.ndarray | No
     # Cycles divides its light passes by Diffuse Color per channel and writes 0 where that colour is 0
     # (safe_divide_even_color), so a surface with no diffuse part shows no diffuse light; glossy likewise.
     has_diffuse = albedo > 0
-    diffuse_direct = read_texture(direct["diffuse"], 3) * has_diffuse
-    glossy_direct = read_texture(direct["glossy"], 3) * (glossy_color > 0)
+    diffuse_direct = direct["diffuse"] * has_diffuse
+    glossy_direct = direct["glossy"] * (glossy_color > 0)
     diffuse_indirect = np.zeros_like(diffuse_direct) if indirect is None else indirect * has_diffuse
     traced = np.zeros(albedo.shape[:2] + (1,), bool) if glossy is None else glossy[..., 3:4] > 0.5
     stand_in = np.zeros_like(diffuse_direct) if indirect is None else indirect

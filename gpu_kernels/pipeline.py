@@ -215,7 +215,7 @@ class Pipeline:
         check_method(settings)  # no camera needed
         frame = self._direct_passes(scene, settings, samples)
         tex = self._direct_light(frame, None)
-        return read_texture(tex["diffuse"], 3)[::-1], frame
+        return tex["diffuse"][::-1], frame
 
     def _direct_light(self, frame, material_lut) -> dict:
         """The direct_light pass, and before it the sky light's visibility, kept apart (sky_visibility): it depends
@@ -224,8 +224,12 @@ class Pipeline:
         sky = self.cache.run("sky_visibility", (frame.keys["gbuffer"], sh.sky_key(frame.shadows)),
                              lambda: lighting.render_sky_visibility(self.ctx, self.programs, frame.gbuffer,
                                                                     frame.shadows, material_lut))
+        # Each group of lights keeps its images while its lights do not change (direct/lighting.light_groups): from
+        # the kept output of the same G-buffer and shadow settings, a light's edit re-lights that light alone.
+        prior = next((v for k, v in self.cache.kept("direct_light") if k[0] == frame.keys["gbuffer"]
+                      and k[1][4] == frame.keys["shadow"][4]), None)
         return self.cache.run("direct_light", frame.keys["direct"], lambda: lighting.render_direct_light(
-            self.ctx, self.programs, frame.gbuffer, frame.shadows, material_lut, sky))
+            self.ctx, self.programs, frame.gbuffer, frame.shadows, material_lut, sky, prior))
 
     @staticmethod
     def _method_output(frame):

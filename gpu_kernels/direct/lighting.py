@@ -1,29 +1,99 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""Diffuse Direct and Glossy Direct: every G-buffer pixel lit by every light, shadowed (direct/light.glsl)."""
+"""Diffuse Direct and Glossy Direct: every G-buffer pixel lit by every light, shadowed (direct/light.glsl), by groups
+of lights whose images a later frame reuses where their lights did not change."""
 from __future__ import annotations
 
+from dataclasses import dataclass
+
+import numpy as np
+
 from ..common import lights as lb
-from ..gl.bind import bind_lights, bind_samplers, dispatch, set_uniform, set_uniforms
+from ..gl.bind import bind_lights, bind_samplers, dispatch, read_texture, set_uniform, set_uniforms, ssbo
+from ..scene import hash_parts
 from .gbuffer import GBuffer
 from .shadows import ShadowAtlas
 
 
-def render_direct_light(ctx, programs, gbuffer: GBuffer, shadows: ShadowAtlas, material_lut=None, sky=None) -> dict:
-    """{"diffuse": Diffuse Direct (irradiance/π), "glossy": Glossy Direct} for every G-buffer pixel, as RGBA32F
-    textures. `material_lut`: the materials' Principled table (direct/geometry.MaterialTextures.lut); None for
-    G-buffers with no camera (the surface atlas), whose Glossy Direct is 0. `sky`: the sky light's shares from
-    render_sky_visibility (None: computed here)."""
-    w, h = gbuffer.size
-    out = {name: ctx.texture((w, h), 4, dtype="f4") for name in ("diffuse", "glossy")}
-    prog = programs.compute("direct/light.glsl")
-    out["diffuse"].bind_to_image(0, read=False, write=True)
-    out["glossy"].bind_to_image(1, read=False, write=True)
-    unit = _bind_inputs(prog, gbuffer, shadows, material_lut)
-    if sky is not None:
-        bind_samplers(prog, "u_sky_shares", [sky], unit)
-    set_uniform(prog, "u_sky_cached", sky is not None)
-    dispatch(prog, (w, h), local=8)
+MAX_UNIT_GROUPS = 16  # lights lit alone per unit of their colour (each keeps two images); the rest share a group
+
+
+@dataclass
+class LightGroup:
+    """Lights lit together by one run of direct/light.glsl: `key` says what their light at the pixels is made of
+    (with the G-buffer); `unit`: lit per unit of colour, scaled by the light's colour when summed."""
+    key: str
+    lights: list
+    unit: bool
+
+
+def light_groups(shadows: ShadowAtlas) -> list[LightGroup]:
+    """The lights in the groups a Diffuse Direct pass sums: each scene light and the sky alone, per unit of its
+    colour (a power, colour or world edit only rescales it, a move re-lights it alone), and an emissive mesh's
+    clusters together with their colours (they change only with the geometry and materials), as do the lights past
+    MAX_UNIT_GROUPS. Keys from shadows.light_keys (a light's record without its colour and its packed views)."""
+    records = shadows.buffers.lights
+    alone, shared = [], []
+    for i, rec in enumerate(records):
+        emitter = int(rec["color_type"][3]) == lb.LIGHT_POLYGON and rec["polygon"][3] > 0.5  # a triangle list
+        (shared if emitter or len(alone) >= MAX_UNIT_GROUPS else alone).append(i)
+    groups = [LightGroup(shadows.light_keys[i], [i], True) for i in alone]
+    if shared:
+        key = hash_parts([shadows.light_keys[i] for i in shared], records["color_type"][shared])
+        groups.append(LightGroup(key, shared, False))
+    return groups
+
+
+def render_direct_light(ctx, programs, gbuffer: GBuffer, shadows: ShadowAtlas, material_lut=None, sky=None,
+                        prior: dict | None = None) -> dict:
+    """{"diffuse": Diffuse Direct (irradiance/π), "glossy": Glossy Direct} for every G-buffer pixel, (H, W, 3)
+    float32 as gl/bind.read_texture gives a texture. `material_lut`: the materials' Principled table
+    (direct/geometry.MaterialTextures.lut); None for G-buffers with no camera (the surface atlas), whose Glossy
+    Direct is 0. `sky`: the sky light's shares from render_sky_visibility (None: computed here). The lights are lit
+    by groups (light_groups) and summed; "groups" keeps each group's images by key, and a group whose key `prior`
+    (an earlier output for the same G-buffer, shadow settings and material table) holds is not lit again ("relit":
+    the groups that were)."""
+    groups = light_groups(shadows)
+    kept = prior["groups"] if prior is not None else {}
+    images = {g.key: kept[g.key] if g.key in kept else None for g in groups}
+    todo = [g for g in groups if images[g.key] is None]
+    if todo:
+        textures = [ctx.texture(gbuffer.size, 4, dtype="f4") for _ in range(2)]
+        prog = programs.compute("direct/light.glsl")
+        unit_records = shadows.buffers.lights.copy()
+        unit_records["color_type"][:, :3] = 1.0
+        unit_ssbo = ssbo(ctx, unit_records)
+        for g in todo:
+            # The inputs again for each group: the previous group's read-back re-bound texture units.
+            unit = _bind_inputs(prog, gbuffer, shadows, material_lut)
+            if sky is not None:
+                bind_samplers(prog, "u_sky_shares", [sky], unit)
+            set_uniform(prog, "u_sky_cached", sky is not None)
+            (unit_ssbo if g.unit else shadows.light_ssbo).bind_to_storage_buffer(0)
+            images[g.key] = _render_group(ctx, prog, gbuffer, g.lights, textures)
+        for obj in textures + [unit_ssbo]:
+            obj.release()
+    out = {"diffuse": 0.0, "glossy": 0.0, "groups": images, "relit": len(todo)}
+    for g in groups:  # in the groups' order, so that a cold render sums alike
+        scale = shadows.buffers.lights["color_type"][g.lights[0], :3] if g.unit else 1.0
+        for name, image in zip(("diffuse", "glossy"), images[g.key]):
+            out[name] = out[name] + image * np.asarray(scale, np.float32)
+    h, w = gbuffer.size[1], gbuffer.size[0]
+    for name in ("diffuse", "glossy"):
+        out[name] = np.broadcast_to(np.asarray(out[name], np.float32), (h, w, 3)).copy()
     return out
+
+
+def _render_group(ctx, prog, gbuffer: GBuffer, lights: list, textures: list) -> tuple:
+    """One group's Diffuse Direct and Glossy Direct, drawn into `textures` and read back; `prog` has its inputs and
+    light records bound."""
+    for binding, tex in enumerate(textures):
+        tex.bind_to_image(binding, read=False, write=True)
+    members = ssbo(ctx, np.asarray(lights, np.int32))
+    members.bind_to_storage_buffer(9)
+    set_uniform(prog, "u_group_count", len(lights))
+    dispatch(prog, gbuffer.size, local=8)
+    members.release()
+    return tuple(read_texture(tex, 3) for tex in textures)
 
 
 def render_sky_visibility(ctx, programs, gbuffer: GBuffer, shadows: ShadowAtlas, material_lut=None):

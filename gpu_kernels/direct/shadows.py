@@ -69,20 +69,21 @@ def render_shadow_atlas(ctx, programs, scene: Scene, geometry: GeometryBuffers,
     views = atlas.pack_views(buffers.views, tiles, size, settings.pcf_radius, buffers.view_lights)
     return ShadowAtlas(depth, size, ssbo(ctx, buffers.lights), ssbo(ctx, views), ssbo(ctx, buffers.polygon_vertices),
                        len(buffers.lights), len(buffers.views), warnings, buffers, owns_depth=depth_pass is None,
-                       views_key=views_key(buffers, key, views), light_keys=light_signatures(buffers))
+                       views_key=views_key(buffers, key, views), light_keys=light_signatures(buffers, views))
 
 
-def light_signatures(buffers: lb.LightBuffers) -> list:
-    """Per light, a key of what its shadow maps and its light are made from besides its colour: its record (colour
-    left out), its polygon and its views. An edit that leaves a light's key leaves whatever was made from that
-    light alone: the sky's visibility (pipeline.py), a light's first bounce (lpv/passes.first_bounce)."""
-    rows, owner = view_rows(buffers.views), np.asarray(buffers.view_lights or [], np.int64)
+def light_signatures(buffers: lb.LightBuffers, packed: np.ndarray) -> list:
+    """Per light, a key of what its shadow maps and its light are made from besides its colour (and the geometry):
+    its record (colour left out), its polygon and its views as packed (atlas.pack_views: projection, tile, texel
+    size, PCF radius). An edit that leaves a light's key leaves whatever was made from that light alone: its
+    Diffuse Direct (direct/lighting.py), the sky's visibility (pipeline.py), its first bounce (lpv/passes.py)."""
+    owner = np.asarray(buffers.view_lights or [], np.int64)
     out = []
     for i, rec in enumerate(buffers.lights):
         rec = rec.copy()
         rec["color_type"][:3] = 0.0
         first, count = int(rec["polygon"][0]), int(rec["polygon"][1])
-        out.append(hash_parts(rec, buffers.polygon_vertices[first:first + count], rows[owner == i]))
+        out.append(hash_parts(rec, buffers.polygon_vertices[first:first + count], packed[owner == i]))
     return out
 
 

@@ -96,8 +96,10 @@ def bind_grid(prog, grid, levels: int | None = None) -> None:
 
 # The shadow atlas read without comparison (direct/eval.glsl u_shadow_depth: the soft shadows' blocker search) is a
 # sampler object on the atlas, bound on a unit nothing else uses: a sampler stays bound to its unit and would
-# override the filtering of any other texture put there.
-RAW_DEPTH_UNIT = 31
+# override the filtering of any other texture put there. Not the last unit (31 of the 32 a stage may read): moderngl
+# binds every texture it makes, reads or writes there (its default_texture_unit), which took the atlas's place
+# between binding the lights and a dispatch.
+RAW_DEPTH_UNIT = 30
 
 
 def bind_lights(prog, shadows, unit: int, sky_stride: int = 1) -> int:

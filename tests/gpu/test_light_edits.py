@@ -1,8 +1,9 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """A light's edit redoes that light's work only: its shadow maps (direct/shadows.render_depth), its RSM views
-(lpv/rsm.render_rsm) and its first bounce (lpv/passes.first_bounce) are redrawn and re-binned into what the other
-lights kept, and the sky's visibility is kept when another light moves — and every pass is still exactly what a
-cold render of the edited scene gives."""
+(lpv/rsm.render_rsm), its first bounce (lpv/passes.first_bounce) and its Diffuse and Glossy Direct
+(direct/lighting.light_groups) are redrawn, re-binned and re-lit beside what the other lights kept, the sky's
+visibility is kept when another light moves, and a power edit re-lights nothing — and every pass is still exactly
+what a cold render of the edited scene gives."""
 import numpy as np
 import pytest
 
@@ -19,8 +20,15 @@ def point(name, x, y, z, power=40.0):
     return Light(name, "POINT", (1.0, 0.9, 0.8), power, m)
 
 
+def area(name, x, y, z, power=60.0):
+    """A square light facing down: its soft shadows read the raw depth atlas (direct/eval.glsl patch_visibility)."""
+    m = np.eye(4)  # Blender's area lights shine along their local −z
+    m[:3, 3] = (x, y, z)
+    return Light(name, "AREA", (0.8, 0.9, 1.0), power, m, shape="SQUARE", size=0.5)
+
+
 def scene(lights):
-    """A floor and a box under two point lights and a grey sky."""
+    """A floor and a box under a point light, an area light and a grey sky."""
     floor = quad([(-5, -5, 0), (5, -5, 0), (5, 5, 0), (-5, 5, 0)], (0, 0, 1))
     quads = [(floor, 0)] + box_quads((-0.5, -0.5, 0.0), (0.5, 0.5, 1.0), 1, inward=False)
     s = quad_scene(quads, [Material("floor", (0.6, 0.6, 0.6)), Material("box", (0.8, 0.3, 0.2))], lights,
@@ -52,19 +60,28 @@ def test_moving_one_light_redraws_only_its_work_and_matches_a_cold_render(engine
     warm, cold = engines
     settings = RenderSettings(method="lpv", width=96, height=72, shadow=ShadowSettings(
         cube_resolution=128, sky_directions=64, sky_resolution=64))
-    lights = [point("a", -2.0, -1.0, 3.0), point("b", 2.0, 1.5, 2.5)]
+    lights = [point("a", -2.0, -1.0, 3.0), area("b", 2.0, 1.5, 2.5)]
     warm.render(scene(lights), settings)
     entries = warm.pipeline.cache.entries
+    cubes = {0: 6, 1: 6 * 4}  # the point light's cube, the area light's 2 × 2 sample points' cubes
     views = entries["shadow_depth"].value.drawn
-    assert views == 6 + 6 + 64 and entries["rsm"].value.drawn == views  # two cubes and the sky's maps
-    assert entries["lpv_inject"].value.binned == 3
-    for moved in (0, 1):
-        lights[moved] = point(lights[moved].name, lights[moved].matrix_world[0, 3] + 0.3, 0.2, 2.8)
+    assert views == cubes[0] + cubes[1] + 64 and entries["rsm"].value.drawn == views  # and the sky's maps
+    assert entries["lpv_inject"].value.binned == 3 and entries["direct_light"].value["relit"] == 3
+    for moved in (0, 1, "power"):
+        make = (point, area)[1 if moved == "power" else moved]
+        if moved == "power":  # a brighter light: the same images, rescaled
+            lights[1] = make(lights[1].name, *lights[1].matrix_world[:3, 3], power=2.0 * lights[1].power)
+        else:
+            lights[moved] = make(lights[moved].name, lights[moved].matrix_world[0, 3] + 0.3, 0.2, 2.8)
         edited = scene(lights)
         result = warm.render(edited, settings)
-        assert entries["shadow_depth"].value.drawn == 6  # the moved light's cube only
-        assert entries["rsm"].value.drawn == 6
-        assert entries["lpv_inject"].value.binned == 1
+        if moved == "power":
+            assert {"shadow_depth", "rsm", "lpv_inject"} <= set(result.skipped)
+        else:
+            assert entries["shadow_depth"].value.drawn == cubes[moved]  # the moved light's cubes only
+            assert entries["rsm"].value.drawn == cubes[moved]
+            assert entries["lpv_inject"].value.binned == 1
+        assert entries["direct_light"].value["relit"] == (0 if moved == "power" else 1)
         assert "sky_visibility" in result.skipped
         fresh = cold.render(edited, settings)
         cold.clear_cache()

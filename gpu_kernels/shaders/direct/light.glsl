@@ -24,6 +24,9 @@ uniform vec3 u_forward;
 uniform bool u_ortho;
 uniform int u_light_count;
 uniform ivec2 u_size;
+// The pass runs once per group of lights (direct/lighting.py light_groups): these u_group_count lights.
+uniform int u_group_count;
+layout(std430, binding = 9) readonly buffer GroupLights { int group_lights[]; };
 // The sky light's shares come from the sky_visibility pass (MODE_SKY, direct/lighting.py) where u_sky_cached:
 // they depend on the G-buffer and the sky's shadow maps only, so a world colour edit reads them back.
 uniform bool u_sky_cached;
@@ -98,7 +101,8 @@ void main() {
     return;
 #endif
     vec3 irradiance = vec3(0.0), reflected = vec3(0.0), world = vec3(0.0);
-    for (int i = 0; i < u_light_count; ++i) {
+    for (int j = 0; j < u_group_count; ++j) {
+        int i = group_lights[j];
         if (int(lights[i].color_type.w) == LIGHT_SKY) {
             // The world: irradiance π·L and, for any roughness, its reflection L (Glossy Color divided out; Cycles
             // counts the world a mirror shows as direct light too), each times its share of the sky that is seen.
