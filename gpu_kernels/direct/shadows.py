@@ -106,7 +106,7 @@ def views_key(buffers: lb.LightBuffers, depth: str, packed) -> str:
 def depth_key(views: list, tiles: list, size: tuple) -> str:
     """What the depth atlas is drawn from besides the geometry: each view's projection, eye and depth range, and
     where its tile lies."""
-    return hash_parts([(v.view_projection, v.origin, v.far) for v in views], [tuple(t) for t in tiles], tuple(size))
+    return hash_parts(view_rows(views), np.asarray(tiles, np.int64).reshape(-1, 4), tuple(size))
 
 
 @dataclass
