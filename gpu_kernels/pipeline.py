@@ -9,6 +9,8 @@ Passes and their inputs (a pass re-runs only when one of its inputs changed — 
                     the camera, world
       shadow_depth← geometry, the shadow views (their depth atlas: a light's power or the world's colour
                     moves no view, so it is kept)
+      light_sources← geometry, materials, shadow settings, the closed emitters (the emissive meshes' lights and
+                    the sky's views: common/lights.static_lights)
     gbuffer       ← geometry, materials, camera, resolution
     sky_visibility← gbuffer, the sky's shadow views (its visible shares: a world colour edit or another
                     light's move keeps them)
@@ -262,7 +264,9 @@ class Pipeline:
         shadows = cache.run("shadow_maps", keys["shadow"], lambda: sh.render_shadow_atlas(
             ctx, programs, scene, geometry, settings.shadow, trapping,
             depth_pass=lambda key, render: cache.run("shadow_depth", (keys["geometry"], key), lambda: render(
-                next((v for k, v in cache.kept("shadow_depth") if k[0] == keys["geometry"]), None)))))
+                next((v for k, v in cache.kept("shadow_depth") if k[0] == keys["geometry"]), None))),
+            static_pass=lambda make: cache.run("light_sources", (keys["geometry"], keys["materials"],
+                                                                 repr(settings.shadow), around), make)))
         keys["gbuffer"] = (keys["geometry"], keys["materials"], keys["camera"])
         if samples is None:
             gbuffer = cache.run("gbuffer", keys["gbuffer"], lambda: gb.render_gbuffer(

@@ -238,11 +238,27 @@ class _Records:
         return LightBuffers(lights, self.views, vertices, self.warnings, self.view_lights, self.skipped)
 
 
-def build_light_buffers(scene: Scene, settings: ShadowSettings | None = None, trapping: list | None = None
-                        ) -> LightBuffers:
-    """Pack every light (and emissive triangle) into GPU records and list the shadow views they sample.
-    `trapping`: the closed emitters whose inner light is trapped (default emitters.trapping_shells(scene))."""
+@dataclass
+class StaticLights:
+    """The lights that only the geometry, the materials and the settings place: the emissive meshes' clusters (the
+    arguments of their records) and the sky's shadow views. A pipeline keeps them across light and world edits."""
+    emitters: list  # (args, kwargs) of _Records.add
+    sky_views: list  # ShadowView per sky direction
+
+
+def static_lights(scene: Scene, settings: ShadowSettings | None = None, trapping: list | None = None) -> StaticLights:
+    """The emitters' records and the sky's views of `scene` (build_light_buffers takes them)."""
     s = settings or ShadowSettings()
+    return StaticLights(_emitter_lights(scene, s, trapping), _sky_views(scene, s))
+
+
+def build_light_buffers(scene: Scene, settings: ShadowSettings | None = None, trapping: list | None = None,
+                        static: StaticLights | None = None) -> LightBuffers:
+    """Pack every light (and emissive triangle) into GPU records and list the shadow views they sample.
+    `trapping`: the closed emitters whose inner light is trapped (default emitters.trapping_shells(scene)).
+    `static`: static_lights of this scene's geometry, materials, settings and trapping (made here if None)."""
+    s = settings or ShadowSettings()
+    static = static or static_lights(scene, s, trapping)
     out = _Records()
     for light in scene.lights:
         reason = unreachable(scene, light)
@@ -250,19 +266,21 @@ def build_light_buffers(scene: Scene, settings: ShadowSettings | None = None, tr
             out.skipped.append(f"light '{light.name}': {reason}")
             continue
         _add_lamp(out, scene, light, s)
-    _add_emissive(out, scene, s, trapping)
-    _add_sky(out, scene, s)
+    for args, kwargs in static.emitters:
+        out.add(*args, **kwargs)
+    radiance = np.asarray(scene.world.color, np.float64)[:3]
+    if max(radiance) > 0 and len(scene.positions):
+        out.add(LIGHT_SKY, radiance, light_views=static.sky_views, samples=len(static.sky_views), per=1)
     return out.finish()
 
 
-def _add_sky(out: _Records, scene: Scene, s: ShadowSettings) -> None:
-    """The world as one light of radiance L (its colour × strength) from every direction, shadowed from
+def _sky_views(scene: Scene, s: ShadowSettings) -> list:
+    """The world is one light of radiance L (its colour × strength) from every direction, shadowed from
     `sky_directions` directions d_k, each an orthographic map looking along −d_k whose ShadowView.emitter holds
     (d_k, its solid angle 4π/K): direct/eval.glsl weighs their visibility by cosine (diffuse) or by the glossy
-    lobe, lpv/inject.glsl lights each map's texels with L·(4π/K)."""
-    radiance = np.asarray(scene.world.color, np.float64)[:3]
-    if max(radiance) <= 0 or not len(scene.positions):
-        return
+    lobe, lpv/inject.glsl lights each map's texels with L·(4π/K). These views, whatever the world's colour."""
+    if not len(scene.positions):
+        return []
     dirs = cam.sphere_directions(s.sky_directions) if s.sky_directions > 0 else np.zeros((0, 3))
     share = 4 * math.pi / max(len(dirs), 1)
     v = []
@@ -272,7 +290,7 @@ def _add_sky(out: _Records, scene: Scene, s: ShadowSettings) -> None:
         # next direction's edge lies).
         view.emit_normal, view.emit_share, view.pcf_radius = d, share, 0
         v.append(view)
-    out.add(LIGHT_SKY, radiance, light_views=v, samples=len(v), per=1)
+    return v
 
 
 def unreachable(scene: Scene, light: Light) -> str:
@@ -340,20 +358,24 @@ def triangle_list_vertices(vertices: np.ndarray, radiance: np.ndarray, color: np
     return out.reshape(-1, 4)
 
 
-def _add_emissive(out: _Records, scene: Scene, s: ShadowSettings, trapping: list | None) -> None:
+def _emitter_lights(scene: Scene, s: ShadowSettings, trapping: list | None) -> list:
     """Every emissive triangle, in ≤ emissive_sample_budget/2 two-sided polygon lights (common/emitters.py), each
-    shadowed from its sample points on both sides of the surface (not the trapped inner side of a closed one)."""
+    shadowed from its sample points on both sides of the surface (not the trapped inner side of a closed one): the
+    (args, kwargs) of their records (_Records.add)."""
     half = max(1, s.emissive_sample_budget // 2)
     clusters = [(c, [x for x in em.side_samples(c) if not x[3]])
                 for c in em.cluster_emitters(scene, half, half, trapping)]
     resolution = emitter_cube_resolution(sum(len(samples) for _, samples in clusters), s)
+    out = []
     for c, samples in clusters:
         color = c.radiance.max(axis=0)
         v = []
         for point, normal, share, _ in samples:
             v.extend(cube_views(point, resolution, *_near_far(scene, point), normal, share / c.area))
-        out.add(LIGHT_POLYGON, color, c.centroid, 0.0, c.normal, light_views=v, samples=len(samples), per=6,
-                poly=triangle_list_vertices(c.vertices, c.radiance, color, c.one_sided), two_sided=True)
+        out.append(((LIGHT_POLYGON, color, c.centroid, 0.0, c.normal), dict(
+            light_views=v, samples=len(samples), per=6, two_sided=True,
+            poly=triangle_list_vertices(c.vertices, c.radiance, color, c.one_sided))))
+    return out
 
 
 def emitter_cube_resolution(cubes: int, s: ShadowSettings) -> int:

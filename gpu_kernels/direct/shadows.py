@@ -47,14 +47,20 @@ class ShadowAtlas:
 
 
 def render_shadow_atlas(ctx, programs, scene: Scene, geometry: GeometryBuffers,
-                        settings: lb.ShadowSettings, trapping: list | None = None, depth_pass=None) -> ShadowAtlas:
+                        settings: lb.ShadowSettings, trapping: list | None = None, depth_pass=None,
+                        static_pass=None) -> ShadowAtlas:
     """Render every light's shadow views into one depth atlas and upload the light/view/polygon buffers.
     `trapping`: the closed emitters whose inner light is trapped (common/emitters.trapping_shells).
     `depth_pass(key, render)`: where the depth atlas is cached apart (the pipeline's 'shadow_depth' pass), keyed by
     `depth_key` of the views; a light's power or colour, or the world's, moves no view, so such an edit renders no
     depth. It calls render(prior), prior a DepthAtlas of the same geometry or None (render_depth). None: rendered
-    here, and the atlas owns it."""
-    buffers = lb.build_light_buffers(scene, settings, trapping)
+    here, and the atlas owns it. `static_pass(make)`: where the emitters' and the sky's lights are cached apart
+    (common/lights.static_lights: a lamp's or the world's edit does not move them); None: made here."""
+    def make_static():
+        return lb.static_lights(scene, settings, trapping)
+
+    static = make_static() if static_pass is None else static_pass(make_static)
+    buffers = lb.build_light_buffers(scene, settings, trapping, static)
     max_size = ctx.info.get("GL_MAX_TEXTURE_SIZE", 16384)
     tiles, size, scale = atlas.allocate_atlas([v.resolution for v in buffers.views], max_height=max_size)
     warnings = list(buffers.warnings)

@@ -241,8 +241,7 @@ def test_pipeline_reruns_only_what_changed(engine, settings):
     assert ALL_PASSES <= set(first.timings)
     check_direct(first.passes, scene.lights[0], -30.0)
 
-    # Same scene (rebuilt, equal content): every pass is skipped, timings 0, the same passes come back.
-    # (The depth atlas is asked for only when the shadow maps re-run.)
+    # Same scene (rebuilt, equal content): every pass skipped, timings 0, the same passes (the depth atlas: unasked).
     second = engine.render(make_scene(sun(-30.0), cam1), settings)
     assert set(second.skipped) == ALL_PASSES - {"shadow_depth"}
     assert all(second.timings[p] == 0.0 for p in ALL_PASSES - {"shadow_depth"})
@@ -252,7 +251,8 @@ def test_pipeline_reruns_only_what_changed(engine, settings):
     # Move only the light: shadows and lighting re-run; geometry, textures, G-buffer, sky (there is none) do not.
     moved = make_scene(sun(-50.0), cam1)
     third = engine.render(moved, settings)
-    assert set(third.skipped) == {"geometry", "textures", "emitter_shells", "gbuffer", "sky_visibility"}
+    assert set(third.skipped) == {"geometry", "textures", "emitter_shells", "light_sources", "gbuffer",
+                                  "sky_visibility"}
     assert {"shadow_depth", "shadow_maps", "direct_light", "compose"}.isdisjoint(third.skipped)
     check_direct(third.passes, moved.lights[0], -50.0)
     np.testing.assert_array_equal(third.passes["Position"], first.passes["Position"])
@@ -269,12 +269,12 @@ def test_pipeline_reruns_only_what_changed(engine, settings):
     world = make_scene(sun(-50.0), cam2)
     world.world.color = (0.1, 0.2, 0.3)
     fifth = engine.render(world, settings)
-    assert set(fifth.skipped) == {"geometry", "textures", "emitter_shells", "gbuffer"}
+    assert set(fifth.skipped) == {"geometry", "textures", "emitter_shells", "light_sources", "gbuffer"}
 
     # Another world colour, and then a brighter sun: the lights' records change, no shadow view does, so the
     # depth atlas (the sky's 576 maps among them) and the sky's visible shares are kept — and the image is what a
     # cold render gives.
-    kept = {"geometry", "textures", "emitter_shells", "shadow_depth", "gbuffer", "sky_visibility"}
+    kept = {"geometry", "textures", "emitter_shells", "light_sources", "shadow_depth", "gbuffer", "sky_visibility"}
     recoloured = make_scene(sun(-50.0), cam2)
     recoloured.world.color = (0.3, 0.2, 0.1)
     sixth = engine.render(recoloured, settings)
