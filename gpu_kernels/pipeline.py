@@ -228,8 +228,8 @@ class Pipeline:
                                                                     frame.shadows, material_lut))
         # Each group of lights keeps its images while its lights do not change (direct/lighting.light_groups): from
         # the kept output of the same G-buffer and shadow settings, a light's edit re-lights that light alone.
-        prior = next((v for k, v in self.cache.kept("direct_light") if k[0] == frame.keys["gbuffer"]
-                      and k[1][4] == frame.keys["shadow"][4]), None)
+        prior = self.cache.prior("direct_light", lambda k: k[0] == frame.keys["gbuffer"]
+                                 and k[1][4] == frame.keys["shadow"][4])
         return self.cache.run("direct_light", frame.keys["direct"], lambda: lighting.render_direct_light(
             self.ctx, self.programs, frame.gbuffer, frame.shadows, material_lut, sky, prior))
 
@@ -264,7 +264,7 @@ class Pipeline:
         shadows = cache.run("shadow_maps", keys["shadow"], lambda: sh.render_shadow_atlas(
             ctx, programs, scene, geometry, settings.shadow, trapping,
             depth_pass=lambda key, render: cache.run("shadow_depth", (keys["geometry"], key), lambda: render(
-                next((v for k, v in cache.kept("shadow_depth") if k[0] == keys["geometry"]), None))),
+                cache.prior("shadow_depth", lambda k: k[0] == keys["geometry"]))),
             static_pass=lambda make: cache.run("light_sources", (keys["geometry"], keys["materials"],
                                                                  repr(settings.shadow), around), make)))
         keys["gbuffer"] = (keys["geometry"], keys["materials"], keys["camera"])

@@ -28,6 +28,7 @@ class ShadowAtlas:
     owns_depth: bool = True  # False where the depth atlas is cached apart (render_shadow_atlas's depth_pass)
     views_key: str = ""  # views_key: what the maps and records are besides the lights' colours
     light_keys: list = None  # light_signatures: the same, per light
+    rows: np.ndarray = None  # view_rows of buffers.views: what each view's maps are drawn from
     _raw: object = None
 
     def raw_depth(self):
@@ -67,15 +68,17 @@ def render_shadow_atlas(ctx, programs, scene: Scene, geometry: GeometryBuffers,
     if scale > 1:
         warnings.append(f"shadow maps reduced {scale}x to fit the atlas ({len(buffers.views)} views)")
 
-    def render(prior=None):
-        return render_depth(ctx, programs, geometry, buffers.views, tiles, size, prior)
+    rows = view_rows(buffers.views)
 
-    key = depth_key(buffers.views, tiles, size)
+    def render(prior=None):
+        return render_depth(ctx, programs, geometry, buffers.views, tiles, size, prior, rows)
+
+    key = depth_key(rows, tiles, size)
     depth = (render() if depth_pass is None else depth_pass(key, render)).texture
     views = atlas.pack_views(buffers.views, tiles, size, settings.pcf_radius, buffers.view_lights)
     return ShadowAtlas(depth, size, ssbo(ctx, buffers.lights), ssbo(ctx, views), ssbo(ctx, buffers.polygon_vertices),
                        len(buffers.lights), len(buffers.views), warnings, buffers, owns_depth=depth_pass is None,
-                       views_key=views_key(buffers, key, views), light_keys=light_signatures(buffers, views))
+                       views_key=views_key(buffers, key, views), light_keys=light_signatures(buffers, views), rows=rows)
 
 
 def light_signatures(buffers: lb.LightBuffers, packed: np.ndarray) -> list:
@@ -109,10 +112,10 @@ def views_key(buffers: lb.LightBuffers, depth: str, packed) -> str:
     return hash_parts(depth, packed, records, buffers.polygon_vertices)
 
 
-def depth_key(views: list, tiles: list, size: tuple) -> str:
-    """What the depth atlas is drawn from besides the geometry: each view's projection, eye and depth range, and
-    where its tile lies."""
-    return hash_parts(view_rows(views), np.asarray(tiles, np.int64).reshape(-1, 4), tuple(size))
+def depth_key(rows: np.ndarray, tiles: list, size: tuple) -> str:
+    """What the depth atlas is drawn from besides the geometry: each view's projection, eye and depth range
+    (view_rows), and where its tile lies."""
+    return hash_parts(rows, np.asarray(tiles, np.int64).reshape(-1, 4), tuple(size))
 
 
 @dataclass
@@ -136,18 +139,28 @@ def view_rows(views: list) -> np.ndarray:
                     np.float64).reshape(len(views), 20)
 
 
+def views_to_redraw(prior, tiles: list, size: tuple, rows: np.ndarray) -> list | None:
+    """The indices of the views whose rows (view_rows) differ from those `prior` (a DepthAtlas or an RSM, with
+    .tiles, .size and .views) was drawn from, or None where `prior` cannot be updated: none, or tiled otherwise."""
+    if prior is None or prior.tiles != tiles or prior.size != size:
+        return None
+    return np.nonzero(np.any(rows != prior.views, axis=1))[0].tolist()
+
+
 def render_depth(ctx, programs, geometry: GeometryBuffers, views: list, tiles: list, size: tuple,
-                 prior: DepthAtlas | None = None) -> DepthAtlas:
+                 prior: DepthAtlas | None = None, rows: np.ndarray | None = None) -> DepthAtlas:
     """The depth atlas: every view drawn into its tile (direct/shadow_depth.glsl). With `prior` (an atlas of the
     same geometry, tiled alike) only the views that changed are drawn again, into `prior`, which is returned
-    updated: whoever held it sees the new maps (the pass cache, whose entry it then is)."""
+    updated: whoever held it sees the new maps (the pass cache, whose entry it then is). `rows`: view_rows(views)."""
     import moderngl
 
-    rows, tiles, size = view_rows(views), [tuple(t) for t in tiles], tuple(size)
-    if prior is not None and prior.tiles == tiles and prior.size == size:
-        depth, redraw = prior.texture, np.nonzero(np.any(rows != prior.views, axis=1))[0].tolist()
+    rows = view_rows(views) if rows is None else rows
+    tiles, size = [tuple(t) for t in tiles], tuple(size)
+    redraw = views_to_redraw(prior, tiles, size, rows)
+    if redraw is not None:
+        depth = prior.texture
     else:
-        depth, redraw = ctx.depth_texture(size), None
+        depth = ctx.depth_texture(size)
         depth.compare_func = "<="
         depth.filter = (moderngl.LINEAR, moderngl.LINEAR)
         depth.repeat_x = depth.repeat_y = False

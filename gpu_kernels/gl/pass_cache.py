@@ -77,6 +77,11 @@ class PassCache:
         entries = ([self.entries[name]] if name in self.entries else []) + self.older.get(name, [])
         return [(e.key, e.value) for e in entries]
 
+    def prior(self, name: str, match) -> object:
+        """The newest kept output of `name` whose key `match(key)` accepts, or None: what a pass may update instead
+        of starting over (the depth atlas, the RSM, the first bounce, Diffuse Direct after a light edit)."""
+        return next((value for key, value in self.kept(name) if match(key)), None)
+
     def _retire(self, name: str, entry) -> None:
         """Keep a replaced output among the `keep[name] - 1` older ones, releasing what falls off the end."""
         if entry is None:

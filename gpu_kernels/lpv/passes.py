@@ -47,7 +47,7 @@ def run(frame) -> MethodOutput:
     # The RSMs hold positions, normals and albedo: they follow the lights' views, not their colours.
     k_rsm = (frame.keys["geometry"], frame.keys["materials"], frame.shadows.views_key, s.rsm_resolution, texel)
     # A light's move redraws its own views into the kept RSM of the same geometry and materials (render_rsm).
-    prior = next((v for k, v in cache.kept("rsm") if k[:2] == k_rsm[:2] and k[3:] == k_rsm[3:]), None)
+    prior = cache.prior("rsm", lambda k: k[:2] == k_rsm[:2] and k[3:] == k_rsm[3:])
     maps = cache.run("rsm", k_rsm, lambda: rsm.render_rsm(ctx, programs, scene, frame.geometry, frame.textures,
                                                            frame.shadows, s.rsm_resolution, texel, prior))
     budget = transfer_budget(scene, grids, s)
@@ -134,8 +134,7 @@ def _transfer(frame, grids, k_grids, maps, k_rsm, budget) -> MethodOutput:
     # Each light's first bounce per unit of its colour, binned once (colour-free key: the RSMs' and the clusters'):
     # a colour, power or world edit only rescales them in the solve.
     k_src = (k_rsm, keys["transfer"])
-    prior = next((v for k, v in cache.kept("lpv_inject") if k[1] == k_src[1] and k[0][:2] == k_rsm[:2]
-                  and k[0][3:] == k_rsm[3:]), None)
+    prior = cache.prior("lpv_inject", lambda k: k[1] == k_src[1] and k[0][:2] == k_rsm[:2] and k[0][3:] == k_rsm[3:])
     units = cache.run("lpv_inject", k_src, lambda: first_bounce(
         ctx, programs, maps, frame.shadows, transfers, grids, budget, prior)).units
     colours = frame.shadows.buffers.lights["color_type"][:, :3].astype(np.float64)  # (lights, 3)
@@ -200,8 +199,8 @@ def _transfer_geometry(frame, grids, k_grids, budget) -> tuple:
     albedo = cache.run("lpv_albedo", k_albedo, lambda: [receivers.current_albedo(
         ctx, programs, scene, frame.geometry, frame.textures, gv, materials) for gv in gvs])
     k_tr = (k_gv, budget, s.occlusion)
-    priors = next((value for key, value in cache.kept("lpv_transfer") if key[1:] == k_tr[1:]
-                   and [t.grid for t in value] == list(grids)), [None] * len(gvs))
+    # A kept T of the same grids (k_gv's grid keys), budget and occlusion, made before a geometry edit.
+    priors = cache.prior("lpv_transfer", lambda key: key[1:] == k_tr[1:] and key[0][1] == k_gv[1]) or [None] * len(gvs)
     transfers = cache.run("lpv_transfer", k_tr, lambda: [_build(ctx, programs, gv, grid, budget, s, p)
                                                          for gv, grid, p in zip(gvs, grids, priors)])
     weights = [a * gv.surface_area[None, :, None] for a, gv in zip(albedo, gvs)]  # (2, R, 3) per side

@@ -11,7 +11,7 @@ import numpy as np
 from ..common import atlas
 from ..common import lights as lb
 from ..direct.geometry import draw_by_material
-from ..direct.shadows import view_rows
+from ..direct.shadows import views_to_redraw
 from ..gl.bind import set_uniform, ssbo, write_uniform
 from ..scene import Scene
 
@@ -96,11 +96,10 @@ def render_rsm(ctx, programs, scene: Scene, geometry, textures, shadows, resolut
     res = [view_resolution(resolution, v.ortho, int(buffers.lights[light]["params"][2]), 2 * v.half_extent, texel)
            for v, light in zip(views, view_lights)]
     tiles, size, scale = atlas.allocate_atlas(res, max_height=ctx.info.get("GL_MAX_TEXTURE_SIZE", 16384))
-    tiles, size, rows = [tuple(t) for t in tiles], tuple(size), view_rows(views)
-    if prior is not None and prior.tiles == tiles and prior.size == size:
-        out, redraw = prior, set(np.nonzero(np.any(rows != prior.views, axis=1))[0].tolist())
-    else:
-        out, redraw = _new_rsm(ctx, programs, geometry, size, resolution // scale), None
+    tiles, size, rows = [tuple(t) for t in tiles], tuple(size), shadows.rows
+    redraw = views_to_redraw(prior, tiles, size, rows)
+    out = prior if redraw is not None else _new_rsm(ctx, programs, geometry, size, resolution // scale)
+    redraw = None if redraw is None else set(redraw)
     out.fbo.use()
     if redraw is None:
         out.fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
