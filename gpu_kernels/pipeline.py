@@ -4,17 +4,18 @@
 Passes and their inputs (a pass re-runs only when one of its inputs changed — see gl/pass_cache.py):
     geometry      ← scene geometry
     textures      ← materials (images)
-    emitter_shells← geometry, materials (closed emitters: common/emitters.py)
-    shadow_maps   ← geometry, materials (emissive triangles), lights, shadow settings, which closed emitters hold
+    emitter_shells← geometry, emission (closed emitters: common/emitters.py)
+    shadow_maps   ← geometry, emission (emissive triangles), lights, shadow settings, which closed emitters hold
                     the camera, world
       shadow_depth← geometry, the shadow views (their depth atlas: a light's power or the world's colour
                     moves no view, so it is kept)
-      light_sources← geometry, materials, shadow settings, the closed emitters (the emissive meshes' lights and
+      light_sources← geometry, emission, shadow settings, the closed emitters (the emissive meshes' lights and
                     the sky's views: common/lights.static_lights)
     gbuffer       ← geometry, materials, camera, resolution
-    sky_visibility← gbuffer, the sky's shadow views (its visible shares: a world colour edit or another
-                    light's move keeps them)
-    direct_light  ← gbuffer, shadow_maps, sky_visibility
+    sky_visibility← geometry, shading, camera, the sky's shadow views (its visible shares: a world colour edit or
+                    another light's move keeps them)
+    direct_light  ← geometry, shading, camera, shadow_maps, sky_visibility (scene.material_keys: a dielectric's
+                    base colour edit keeps both)
     <method>      ← the above (lpv/passes.py, vct/passes.py: the indirect light)
     compose       ← everything above, world      (CPU: passes as numpy, Combined)
 
@@ -39,7 +40,7 @@ from .gl.bind import read_texture
 from .gl.pass_cache import PassCache
 from .gl.programs import ProgramCache
 from .lpv import passes as lpv_passes
-from .scene import Scene, hash_parts
+from .scene import Scene, hash_parts, material_keys
 from .settings import METHODS, RenderSettings, check_method, check_renderable
 from .surface import gbuffer as sgb
 from .surface.atlas import SurfaceAtlas
@@ -84,7 +85,8 @@ class SurfaceLight:
 class FrameInputs:
     """What a method's passes read: the GL context, programs and pass cache; the scene and settings; the direct
     passes' outputs; and `keys`, the content keys of the scene parts and passes ("geometry", "materials",
-    "lights", "camera", "world", "shadow", "gbuffer") that the method's own pass keys build on."""
+    "emission", "shading", "lights", "camera", "world", "shadow", "gbuffer", "direct") that the method's own pass
+    keys build on."""
     ctx: object
     programs: ProgramCache
     cache: PassCache
@@ -164,7 +166,8 @@ class Pipeline:
                                   None if indirect is None else indirect[..., :3],
                                   None if out is None or out.glossy is None else read_texture(out.glossy, 4),
                                   indirect[..., 3] if indirect is not None and out.has_ao else None)
-        passes = self.cache.run("compose", (frame.keys["direct"], out and out.key, frame.keys["world"]), compose)
+        passes = self.cache.run("compose", (frame.keys["gbuffer"], frame.keys["direct"], out and out.key,
+                                            frame.keys["world"]), compose)
         timings = dict(self.cache.timings)
         timings["total"] = time.perf_counter() - start
         return RenderResult(passes=passes, timings=timings, skipped=list(self.cache.skipped),
@@ -223,12 +226,12 @@ class Pipeline:
         """The direct_light pass, and before it the sky light's visibility, kept apart (sky_visibility): it depends
         on the G-buffer and the sky's own shadow maps, not on any light's colour nor on the other lights, so a world
         or light colour edit and another light's move skip it."""
-        sky = self.cache.run("sky_visibility", (frame.keys["gbuffer"], sh.sky_key(frame.shadows)),
+        sky = self.cache.run("sky_visibility", (frame.keys["direct"][0], sh.sky_key(frame.shadows)),
                              lambda: lighting.render_sky_visibility(self.ctx, self.programs, frame.gbuffer,
                                                                     frame.shadows, material_lut))
         # Each group of lights keeps its images while its lights do not change (direct/lighting.light_groups): from
         # the kept output of the same G-buffer and shadow settings, a light's edit re-lights that light alone.
-        prior = self.cache.prior("direct_light", lambda k: k[0] == frame.keys["gbuffer"]
+        prior = self.cache.prior("direct_light", lambda k: k[0] == frame.keys["direct"][0]
                                  and k[1][4] == frame.keys["shadow"][4])
         return self.cache.run("direct_light", frame.keys["direct"], lambda: lighting.render_direct_light(
             self.ctx, self.programs, frame.gbuffer, frame.shadows, material_lut, sky, prior))
@@ -243,7 +246,7 @@ class Pipeline:
         The G-buffer is the camera's, or with `samples` that of surface points (render_surface, render_points)."""
         ctx, programs, cache = self.ctx, self.programs, self.cache
         keys = {"geometry": hash_parts(scene.positions, scene.normals, scene.uvs, scene.material_index),
-                "materials": hash_parts(scene.materials, scene.textures), "lights": hash_parts(scene.lights),
+                **material_keys(scene), "lights": hash_parts(scene.lights),
                 "camera": hash_parts(scene.camera, scene.pixel_aspect, settings.width, settings.height)
                 if samples is None else samples.key,
                 "world": hash_parts(scene.world)}
@@ -252,11 +255,11 @@ class Pipeline:
         # Closed emitters trap their inner light unless the camera is inside one (common/emitters.py): the shells
         # depend on geometry and materials only, and the shadow maps on which of them hold the camera, which
         # changes only when the camera crosses one.
-        shells = cache.run("emitter_shells", (keys["geometry"], keys["materials"]), lambda: em.sealed_shells(scene))
+        shells = cache.run("emitter_shells", (keys["geometry"], keys["emission"]), lambda: em.sealed_shells(scene))
         camera = None if scene.camera is None else np.asarray(scene.camera.matrix_world, np.float64)[:3, 3]
         around = em.shells_around(scene, shells, camera)
         trapping = [s for k, s in enumerate(shells) if k not in around]
-        keys["shadow"] = (keys["geometry"], keys["materials"], keys["lights"], keys["world"], repr(settings.shadow),
+        keys["shadow"] = (keys["geometry"], keys["emission"], keys["lights"], keys["world"], repr(settings.shadow),
                          around)
         # The depth atlas is a pass of its own, keyed by the views it draws: a light's power or colour and the
         # world's change the records, not the maps (576 of them for the sky). A light's move redraws its own maps
@@ -265,7 +268,7 @@ class Pipeline:
             ctx, programs, scene, geometry, settings.shadow, trapping,
             depth_pass=lambda key, render: cache.run("shadow_depth", (keys["geometry"], key), lambda: render(
                 cache.prior("shadow_depth", lambda k: k[0] == keys["geometry"]))),
-            static_pass=lambda make: cache.run("light_sources", (keys["geometry"], keys["materials"],
+            static_pass=lambda make: cache.run("light_sources", (keys["geometry"], keys["emission"],
                                                                  repr(settings.shadow), around), make)))
         keys["gbuffer"] = (keys["geometry"], keys["materials"], keys["camera"])
         if samples is None:
@@ -273,7 +276,8 @@ class Pipeline:
                 ctx, programs, scene, geometry, textures, settings.width, settings.height))
         else:
             gbuffer = cache.run("gbuffer", keys["gbuffer"], lambda: sgb.upload_gbuffer(ctx, samples.arrays()))
-        keys["direct"] = (keys["gbuffer"], keys["shadow"])
+        # Direct light reads the G-buffer's surfaces and shading, not a dielectric's base colour (material_keys).
+        keys["direct"] = ((keys["geometry"], keys["shading"], keys["camera"]), keys["shadow"])
         return FrameInputs(ctx, programs, cache, scene, settings, geometry, textures, shadows, gbuffer, keys)
 
     def release(self) -> None:

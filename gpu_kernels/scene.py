@@ -7,7 +7,7 @@ Everything here is in Blender's world space (metres, Z up) and Blender's units (
 from __future__ import annotations
 
 import hashlib
-from dataclasses import dataclass, field, fields, is_dataclass
+from dataclasses import dataclass, field, fields, is_dataclass, replace
 
 import numpy as np
 
@@ -148,6 +148,24 @@ class Scene:
         h = hashlib.sha256()
         _hash_into(h, self)
         return h.hexdigest()[:20]
+
+
+def material_keys(scene: Scene) -> dict:
+    """Content keys of the materials by what reads them: "materials" (everything: the G-buffer, the voxels),
+    "textures" (which materials take their base colour from which image, and the images: what the LPV's RSM holds),
+    "layers" (the Principled layers without any colour: the material table, common/principled.material_lut),
+    "emission" (the emissive triangles' radiance: the lights and shadow maps) and "shading" (what direct light reads
+    of a surface beyond its position: the layers, and the base colour only where a metal's Fresnel takes it — a
+    dielectric's base colour only tints the Diffuse Color that compose multiplies by). A base colour edit of a
+    non-metal changes "materials" alone."""
+    layers = [replace(m, name="", emission=(0.0, 0.0, 0.0), base_color=(0.0, 0.0, 0.0)) for m in scene.materials]
+    metals = [i for i, m in enumerate(scene.materials) if m.metallic != 0]
+    textures = hash_parts([m.base_color_texture for m in scene.materials], scene.textures)
+    layers = hash_parts(layers)
+    return {"materials": hash_parts(scene.materials, textures), "textures": textures, "layers": layers,
+            "emission": hash_parts([m.emission for m in scene.materials]),
+            "shading": hash_parts(layers, [scene.materials[i].base_color for i in metals],
+                                  textures if metals else None)}
 
 
 def finite_normals(positions: np.ndarray, normals: np.ndarray) -> np.ndarray:

@@ -40,7 +40,7 @@ def _update(engine, settings, resolution):
 
 
 def _base_color_socket(material):
-    """The input an edit of 'material colour' changes: Principled / Diffuse Base Color, else the viewport colour."""
+    """The Principled / Diffuse BSDF Base Color input of a material's nodes, where it is a value (not linked)."""
     if material.use_nodes and material.node_tree:
         for node in material.node_tree.nodes:
             for name in ("Base Color", "Color"):
@@ -48,6 +48,15 @@ def _base_color_socket(material):
                 if sock is not None and not sock.is_linked:
                     return sock
     return None
+
+
+def _colour_values(material):
+    """The colour a material edit nudges: its Principled / Diffuse Base Color value, its viewport colour if it uses
+    no nodes (what extraction reads then), or None (its colour is an image or a node tree's)."""
+    socket = _base_color_socket(material)
+    if socket is not None:
+        return socket.default_value
+    return None if material.use_nodes and material.node_tree else material.diffuse_color
 
 
 def _stepper(get, put, value_at):
@@ -111,15 +120,15 @@ def _edits(bpy):
         edits["object_move"] = mover(smallest, 2)
     else:
         edits["object_move"] = "the scene has no mesh object"
-    material = next((s.material for o in meshes for s in o.material_slots if s.material), None)
-    socket = _base_color_socket(material) if material else None
-    if material is not None:
-        values = socket.default_value if socket is not None else material.diffuse_color
+    # the first material whose base colour is a value (an image's colour is no nudge: editing it changed nothing)
+    materials = [s.material for o in meshes for s in o.material_slots if s.material]
+    values = next((v for v in map(_colour_values, materials) if v is not None), None)
+    if values is not None:
         # darker each step where a few brighter steps would leave [0, 1]
         edits["material_change"] = _stepper(*_channel(values, 0), lambda base, k: base + (
             k * STEP if base + 4 * STEP <= 1.0 else -k * STEP))
     else:
-        edits["material_change"] = "no mesh has a material"
+        edits["material_change"] = "no mesh's material has a base colour value (an unlinked Base Color)"
     return edits
 
 

@@ -53,10 +53,12 @@ def upload_geometry(ctx, programs, scene: Scene) -> GeometryBuffers:
 class MaterialTextures:
     """What the material uniforms sample: the scene's images (indexable like Scene.textures) and the materials'
     Principled table (common/principled.py: material_lut) with each material's transport albedo terms
-    (principled.transport_albedo: (scale, offset) rows, (M, 2, 3))."""
+    (principled.transport_albedo: (scale, offset) rows, (M, 2, 3)); `colors`: base_colors, and the storage buffer
+    holding them (`colors_ssbo`, lpv/inject.glsl)."""
 
-    def __init__(self, images: list, lut, transport: np.ndarray):
+    def __init__(self, images: list, lut, transport: np.ndarray, colors: np.ndarray, colors_ssbo=None):
         self.images, self.lut, self.transport = images, lut, transport
+        self.colors, self.colors_ssbo = colors, colors_ssbo
 
     def __len__(self):
         return len(self.images)
@@ -65,8 +67,21 @@ class MaterialTextures:
         return self.images[i]
 
     def release(self):
-        for t in self.images + [self.lut]:
+        for t in self.images + [self.lut] + ([self.colors_ssbo] if self.colors_ssbo is not None else []):
             t.release()
+
+
+def base_colors(scene: Scene, images: int) -> np.ndarray:
+    """(max(M, 1), 4) float32: per material the colour its base colour texture is multiplied by in the RSM's
+    injection (lpv/inject.glsl texel_albedo) — its base colour, or 1 where a texture gives the colour (the RSM
+    holds the texture's) — as bind_material colours a draw; w = 1 for a metal (its albedo is not linear in the
+    colour: common/principled.glsl principled_glossy), else 0."""
+    out = np.zeros((max(len(scene.materials), 1), 4), np.float32)
+    out[:, :3] = 0.8  # bind_material's colour for a material index that names none
+    for i, m in enumerate(scene.materials):
+        out[i, :3] = 1.0 if 0 <= m.base_color_texture < images else m.base_color[:3]
+        out[i, 3] = float(m.metallic != 0)
+    return out
 
 
 def upload_textures(ctx, scene: Scene) -> MaterialTextures:
@@ -88,7 +103,8 @@ def upload_textures(ctx, scene: Scene) -> MaterialTextures:
     lut.filter = (moderngl.LINEAR, moderngl.LINEAR)
     lut.repeat_x = lut.repeat_y = False
     terms = np.array([transport_albedo(m)[:2] for m in scene.materials] or [((1.0,) * 3, (0.0,) * 3)], np.float32)
-    return MaterialTextures(out, lut, terms)
+    colors = base_colors(scene, len(out))
+    return MaterialTextures(out, lut, terms, colors, ctx.buffer(colors.tobytes()))
 
 
 def bind_material(prog, scene: Scene, mat_index: int, textures: MaterialTextures) -> None:

@@ -352,7 +352,7 @@ def bin_flux(clusters: Clusters, records: np.ndarray, cells: np.ndarray | None =
         g = records["flux"][:, 3].astype(np.int64)
         slot = g[keep] * clusters.count + target[keep]
         binned = np.stack([np.bincount(slot, flux[keep, i], groups * clusters.count) for i in range(3)], axis=1)
-        lost = np.stack([np.bincount(g[~keep], flux[~keep, i], groups) for i in range(3)], axis=1)
+        lost = np.stack([np.bincount(g[~keep], flux[~keep, i], groups) for i in range(3)], axis=1).astype(np.float64)
         return binned.reshape(groups, clusters.count, 3), lost
     for i in range(3):
         out[:, i] = np.bincount(target[keep], flux[keep, i], clusters.count)

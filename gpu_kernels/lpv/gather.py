@@ -52,9 +52,16 @@ class VplList:
         self.buffer.release()
 
 
-def rsm_uniforms(prog, rsm, shadows, downsample: int) -> tuple:
-    """Bind what lpv/inject.glsl reads of the RSM and the lights; returns the atlas size in k×k blocks."""
-    bind_named(prog, [("u_rsm_position", rsm.position), ("u_rsm_normal", rsm.normal), ("u_rsm_albedo", rsm.albedo)])
+def rsm_uniforms(prog, rsm, shadows, materials, downsample: int, change: tuple | None = None) -> tuple:
+    """Bind what lpv/inject.glsl reads of the RSM, the materials (direct/geometry.MaterialTextures: the Principled
+    table and base colours) and the lights; returns the atlas size in k×k blocks. `change`: two storage buffers of
+    base_colors rows, (new, old; old's w = 1 where a material's colour changed): the texels' flux is the change."""
+    bind_named(prog, [("u_rsm_position", rsm.position), ("u_rsm_normal", rsm.normal), ("u_rsm_albedo", rsm.albedo),
+                      ("u_material_lut", materials.lut)])
+    new, old = change or (materials.colors_ssbo, materials.colors_ssbo)
+    new.bind_to_storage_buffer(8)
+    old.bind_to_storage_buffer(10)
+    set_uniform(prog, "u_delta", change is not None)
     set_uniform(prog, "u_rsm_size", rsm.size)
     set_uniform(prog, "u_downsample", int(downsample))
     bind_light_records(shadows)
@@ -112,14 +119,18 @@ def _fitted(ctx, records: np.ndarray, size: float, block: int, budget: int) -> V
     return VplList(ctx.buffer(payload), len(records), flux, block)
 
 
-def rsm_records(ctx, programs, rsm, shadows, grid: Grid, budget: int, limit: int | None = None,
-                unit_color: bool = False, lights: np.ndarray | None = None) -> tuple[np.ndarray, int]:
+def rsm_records(ctx, programs, rsm, shadows, materials, grid: Grid, budget: int, limit: int | None = None,
+                unit_color: bool = False, lights: np.ndarray | None = None,
+                change: tuple | None = None) -> tuple[np.ndarray, int]:
     """The RSM as VPL records (VPL_DTYPE) and k: k×k texel blocks (intensity-aware, lpv/inject.glsl MODE_LIST), k the
     smallest power of two whose blocks number at most `limit` (default a few times `budget`: much of an atlas is
     empty, a sun's map covers the whole grid, a spot's cone a disc). A block spanning two surfaces gives two VPLs;
     the grid's cell sets the plane tolerance. Each record's flux.w is its light's index; with `unit_color` its flux
     is per unit of that light's colour (the flux a colour of 1 would give). `lights` (bool per light): only those
-    lights' texels make records (the same records, in the same order, as without it)."""
+    lights' texels make records (the same records, in the same order, as without it). `change` (new, old: two
+    arrays of direct/geometry.base_colors rows, old's w = 1 where a material's colour changed): the records' flux is
+    what the texels of the changed materials reflect at the new colours less at the old (positions and normals alike:
+    they do not depend on the colours), and only the records with a change are returned."""
     prog = programs.compute("lpv/inject.glsl", {"MODE_LIST": 1})
     bind_grid(prog, grid)
     set_uniform(prog, "u_unit_color", bool(unit_color))
@@ -130,7 +141,8 @@ def rsm_records(ctx, programs, rsm, shadows, grid: Grid, budget: int, limit: int
     limit = PRECLUSTER * budget if limit is None else limit
     while k < MAX_BLOCK and -(-rsm.size[0] // k) * -(-rsm.size[1] // k) > limit:
         k *= 2  # cluster on the GPU first, so that the read-back stays a few times the budget
-    blocks = rsm_uniforms(prog, rsm, shadows, k)
+    buffers = None if change is None else tuple(ssbo(ctx, np.asarray(c, np.float32)) for c in change)
+    blocks = rsm_uniforms(prog, rsm, shadows, materials, k, buffers)
     set_uniform(prog, "u_blocks_x", int(blocks[0]))
     boxes = [(0, 0, blocks[0], blocks[1])] if lights is None else [
         (x // k, y // k, -(-w // k), -(-h // k)) for (x, y, w, h), light in zip(rsm.tiles, shadows.buffers.view_lights)
@@ -150,7 +162,10 @@ def rsm_records(ctx, programs, rsm, shadows, grid: Grid, budget: int, limit: int
                     dispatch(prog, (bw, bh), local=8)
             base += 2 * blocks[0] * (y1 - y0)
     records = _collect(ctx, slots, run)
-    mask.release()
+    for buf in (mask,) + (buffers or ()):
+        buf.release()
+    if change is not None:
+        records = records[np.any(records["flux"][:, :3] != 0.0, axis=1)]
     return records, k
 
 
@@ -165,9 +180,9 @@ def _bands(spans: list) -> list:
     return out
 
 
-def vpl_list(ctx, programs, rsm, shadows, grid: Grid, budget: int) -> VplList:
+def vpl_list(ctx, programs, rsm, shadows, materials, grid: Grid, budget: int) -> VplList:
     """The RSM as at most `budget` VPLs: rsm_records merged (`merge`) until they fit."""
-    records, k = rsm_records(ctx, programs, rsm, shadows, grid, budget)
+    records, k = rsm_records(ctx, programs, rsm, shadows, materials, grid, budget)
     return _fitted(ctx, records, grid.cell / 2, k, budget)
 
 

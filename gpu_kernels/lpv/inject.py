@@ -10,12 +10,12 @@ from .rsm import Rsm, flux_bound
 from .state import FIXED_RANGE, LpvGridState, resolve
 
 
-def inject(ctx, programs, rsm: Rsm, shadows, state: LpvGridState, downsample: int = 1) -> float:
+def inject(ctx, programs, rsm: Rsm, shadows, materials, state: LpvGridState, downsample: int = 1) -> float:
     """RSM texels → fixed-point SH sums → state.injected. Returns the injected flux (W, sum of RGB)."""
     scale = FIXED_RANGE / max(flux_bound(shadows.buffers), 1e-30)
     state.accum_ints.clear()
     prog = programs.compute("lpv/inject.glsl")
-    blocks = rsm_uniforms(prog, rsm, shadows, downsample)
+    blocks = rsm_uniforms(prog, rsm, shadows, materials, downsample)
     set_uniform(prog, "u_fixed_scale", float(scale))
     bind_grid(prog, state.grid)
     state.accum_ints.bind_to_storage_buffer(4)
@@ -23,15 +23,16 @@ def inject(ctx, programs, rsm: Rsm, shadows, state: LpvGridState, downsample: in
     return resolve(ctx, programs, state, scale, state.injected)
 
 
-def inject_all(ctx, programs, rsm: Rsm, shadows, grids: list, downsample: int = 1, gather_vpls: int = 0) -> list:
+def inject_all(ctx, programs, rsm: Rsm, shadows, materials, grids: list, downsample: int = 1,
+               gather_vpls: int = 0) -> list:
     """Inject the RSM VPLs into a fresh state per cascade (finest first). With `gather_vpls` > 0 they are listed
     for the gathered first bounce (state.vpls) instead of injected."""
     states = []
     for grid in grids:
         state = LpvGridState(ctx, grid)
         if gather_vpls:
-            state.vpls = vpl_list(ctx, programs, rsm, shadows, grid, gather_vpls)
+            state.vpls = vpl_list(ctx, programs, rsm, shadows, materials, grid, gather_vpls)
         else:
-            state.injected_flux = inject(ctx, programs, rsm, shadows, state, downsample)
+            state.injected_flux = inject(ctx, programs, rsm, shadows, materials, state, downsample)
         states.append(state)
     return states

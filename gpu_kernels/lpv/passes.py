@@ -1,9 +1,9 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """The LPV's passes in the pipeline's pass cache (pipeline.METHOD_PASSES["lpv"]):
 
-    rsm              ← shadow views, RSM resolution
+    rsm              ← shadow views, geometry, textures, RSM resolution (no material colour: lpv/rsm.glsl)
     geometry_volume  ← geometry, materials, grids
-    lpv_inject       ← rsm, grids
+    lpv_inject       ← rsm, materials, grids
     lpv_propagate    ← injection, geometry volume, LPV settings (the transport: gather.gather_all or
                        propagate.propagate_all; with octree levels, octree.py's passes)
     lpv_lighting     ← gbuffer, transport
@@ -15,13 +15,13 @@ alone and the passes are instead:
     lpv_albedo           ← geometry volume, materials          (the surface voxels' albedo)
     lpv_transfer         ← geometry volume, budget             (clusters and the kernel T: the expensive part)
     lpv_transfer_albedo  ← transfer, albedo                    (M_ρ: cluster-to-cluster reflection, bounded)
-    lpv_inject           ← rsm, transfer                       (the RSM's flux per cluster)
+    lpv_inject           ← rsm, transfer, materials            (the RSM's flux per cluster; first_bounce)
     lpv_propagate        ← all of the above, bounces           (the bounce series and one product with T)
     lpv_lighting         ← gbuffer, transport
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -44,9 +44,10 @@ def run(frame) -> MethodOutput:
     grids = cascade_grids(scene, s)
     k_grids = tuple(g.key() for g in grids)
     texel = min(g.cell for g in grids) / RSM_TEXELS_PER_CELL
-    # The RSMs hold positions, normals and albedo: they follow the lights' views, not their colours.
-    k_rsm = (frame.keys["geometry"], frame.keys["materials"], frame.shadows.views_key, s.rsm_resolution, texel)
-    # A light's move redraws its own views into the kept RSM of the same geometry and materials (render_rsm).
+    # The RSMs hold positions, normals, texture colours and material indices: they follow the lights' views, not
+    # their colours nor the materials' (lpv/rsm.glsl).
+    k_rsm = (frame.keys["geometry"], frame.keys["textures"], frame.shadows.views_key, s.rsm_resolution, texel)
+    # A light's move redraws its own views into the kept RSM of the same geometry and textures (render_rsm).
     prior = cache.prior("rsm", lambda k: k[:2] == k_rsm[:2] and k[3:] == k_rsm[3:])
     maps = cache.run("rsm", k_rsm, lambda: rsm.render_rsm(ctx, programs, scene, frame.geometry, frame.textures,
                                                            frame.shadows, s.rsm_resolution, texel, prior))
@@ -57,9 +58,10 @@ def run(frame) -> MethodOutput:
     gvs = cache.run("geometry_volume", k_gv, lambda: occlusion.geometry_volumes(
         ctx, programs, scene, frame.geometry, frame.textures, grids) if s.occlusion else [None] * len(grids))
     gather_vpls = s.gather_vpls if s.gathers else 0
-    k_inject = (k_rsm, frame.keys["shadow"], k_grids, s.rsm_downsample, gather_vpls)  # the lights' colours too
+    # the lights' and the materials' colours too
+    k_inject = (k_rsm, frame.keys["shadow"], frame.keys["materials"], k_grids, s.rsm_downsample, gather_vpls)
     states = cache.run("lpv_inject", k_inject, lambda: inject.inject_all(
-        ctx, programs, maps, frame.shadows, grids, s.rsm_downsample, gather_vpls))
+        ctx, programs, maps, frame.shadows, frame.textures, grids, s.rsm_downsample, gather_vpls))
     k_prop = (k_inject, k_gv, repr(s))
     if s.octree_levels:
         states, gvs, stats, s = _octree(frame, states, gvs, grids, k_gv, k_inject, k_prop)
@@ -131,12 +133,14 @@ def _transfer(frame, grids, k_grids, maps, k_rsm, budget) -> MethodOutput:
     """The cached transport's passes (lpv/transfer.py); see the module docstring for what each reads."""
     ctx, programs, cache, scene, s = frame.ctx, frame.programs, frame.cache, frame.scene, frame.settings.lpv
     gvs, transfers, _, reflection, keys = _transfer_geometry(frame, grids, k_grids, budget)
-    # Each light's first bounce per unit of its colour, binned once (colour-free key: the RSMs' and the clusters'):
-    # a colour, power or world edit only rescales them in the solve.
-    k_src = (k_rsm, keys["transfer"])
-    prior = cache.prior("lpv_inject", lambda k: k[1] == k_src[1] and k[0][:2] == k_rsm[:2] and k[0][3:] == k_rsm[3:])
+    # Each light's first bounce per unit of its colour (colour-free key but for the materials' colours): a light's
+    # colour, power or world edit only rescales them in the solve; from a kept one of the same RSMs, clusters and
+    # material layers, a light's move re-bins that light and a material's colour edit adds its change (first_bounce).
+    k_src = (k_rsm, keys["transfer"], frame.keys["layers"], frame.keys["materials"])
+    prior = cache.prior("lpv_inject", lambda k: k[1:3] == k_src[1:3] and k[0][:2] == k_rsm[:2]
+                        and k[0][3:] == k_rsm[3:])
     units = cache.run("lpv_inject", k_src, lambda: first_bounce(
-        ctx, programs, maps, frame.shadows, transfers, grids, budget, prior)).units
+        ctx, programs, maps, frame.shadows, frame.textures, transfers, grids, budget, prior)).units
     colours = frame.shadows.buffers.lights["color_type"][:, :3].astype(np.float64)  # (lights, 3)
     k_prop = (k_src, frame.keys["shadow"], keys["albedo_transfer"], keys["gv"], s.max_iterations, s.clamp_negative,
               s.bounces, s.epsilon)
@@ -152,33 +156,82 @@ def _transfer(frame, grids, k_grids, maps, k_rsm, budget) -> MethodOutput:
 @dataclass
 class FirstBounce:
     """Each light's first bounce per unit of its colour, binned into each cascade's clusters — (first (lights, C,
-    3), lost (lights, 3)) per cascade — and what each light's was made from (direct/shadows.light_signatures)."""
+    3), lost (lights, 3)) per cascade — and what it was made from: each light's signature
+    (direct/shadows.light_signatures) and the materials' base colours (direct/geometry.base_colors)."""
     units: list
     signatures: list
+    colors: np.ndarray
     binned: int = 0  # lights binned when it was made (the others' rows came from the prior)
+    recolored: int = 0  # materials whose colour edit was added to the prior's rows
+    # (cascade, material) → that material's texels' first bounce per unit of its base colour (first, lost), for
+    # these lights: a later colour edit of the same non-metal is that times the colour's change (recolor).
+    bases: dict = field(default_factory=dict)
 
 
-def first_bounce(ctx, programs, maps, shadows, transfers, grids, budget, prior=None) -> FirstBounce:
+MAX_BASES = 4  # materials whose FirstBounce.bases a pipeline keeps (the ones edited last)
+
+
+def first_bounce(ctx, programs, maps, shadows, materials, transfers, grids, budget, prior=None) -> FirstBounce:
     """The RSMs' texels as VPL records (gather.rsm_records) binned per light into the clusters (clusters.bin_flux).
-    With `prior` (made with the same clusters), only the lights whose signature changed are binned again — a light's
-    move costs that light's texels, not every light's — and the others' rows are the prior's (the same numbers: a
-    light's records and their order do not depend on the other lights)."""
-    signatures = shadows.light_keys
-    redo = None
-    if prior is not None and len(prior.signatures) == len(signatures):
-        redo = np.array([a != b for a, b in zip(signatures, prior.signatures)], bool)
-        if not redo.any():
-            return FirstBounce(prior.units, signatures, 0)
-    units = []
+    With `prior` (made with the same RSMs, clusters and material layers), only the lights whose signature changed
+    are binned again — a light's move costs that light's texels, not every light's; the others' rows are the
+    prior's (a light's records and their order do not depend on the other lights) plus, where materials' colours
+    changed, what the change adds (recolor) — a colour edit costs its material's texels once, then nothing."""
+    signatures, colors = shadows.light_keys, materials.colors
+    if prior is None or len(prior.signatures) != len(signatures) or prior.colors.shape != colors.shape:
+        units = [_bin(ctx, programs, maps, shadows, materials, t, grid, budget, len(signatures))
+                 for t, grid in zip(transfers, grids)]
+        return FirstBounce(units, signatures, colors, len(signatures))
+    redo = np.array([a != b for a, b in zip(signatures, prior.signatures)], bool)
+    recolored = np.any(prior.colors != colors, axis=1)
+    out = FirstBounce([], signatures, colors, int(redo.sum()), int(recolored.sum()),
+                      {} if redo.any() else dict(prior.bases))
     for k, (t, grid) in enumerate(zip(transfers, grids)):
-        records = gather.rsm_records(ctx, programs, maps, shadows, grid, budget, clusters.TEXEL_RECORDS,
-                                     unit_color=True, lights=redo)[0]
-        first, lost = clusters.bin_flux(t.clusters, records, t.cells, t.normals, groups=len(signatures), axis=t.axis)
-        if redo is not None:
-            first = np.where(redo[:, None, None], first, prior.units[k][0])
-            lost = np.where(redo[:, None], lost, prior.units[k][1])
-        units.append((first, lost))
-    return FirstBounce(units, signatures, len(signatures) if redo is None else int(redo.sum()))
+        first, lost = prior.units[k]
+        if redo.any():
+            new = _bin(ctx, programs, maps, shadows, materials, t, grid, budget, len(signatures), lights=redo)
+            first, lost = np.where(redo[:, None, None], new[0], first), np.where(redo[:, None], new[1], lost)
+        if recolored.any() and not redo.all():
+            bin_change = lambda change, lights: _bin(ctx, programs, maps, shadows, materials, t, grid, budget,
+                                                     len(signatures), lights=lights, change=change)
+            first, lost = recolor(first, lost, prior.colors, colors, ~redo, out.bases, k, bin_change)
+        out.units.append((first, lost))
+    while len(out.bases) > MAX_BASES * len(grids):
+        out.bases.pop(next(iter(out.bases)))
+    return out
+
+
+def recolor(first, lost, old, new, lights, bases, cascade, bin_change) -> tuple:
+    """`lights`' rows of (first, lost) with the materials whose base colours (rows of direct/geometry.base_colors)
+    went from `old` to `new` recoloured. A non-metal's albedo is linear in its colour (c·D(μ) + a glossy part
+    without it), so its change is (new − old) × its basis, the first bounce of its texels per unit colour, binned
+    once into `bases` (by bin_change((new, old) colour rows, lights): all lights, from 0 to 1); a metal's change
+    is binned as it is (Fresnel takes the colour)."""
+    changed = np.any(old != new, axis=1)
+    first, lost = np.array(first, np.float64), np.array(lost, np.float64)
+    for m in np.nonzero(changed & (new[:, 3] == 0))[0]:
+        key = (cascade, int(m))
+        if key not in bases:
+            unit, zero = np.zeros_like(new), np.zeros_like(new)
+            unit[m, :3], zero[m, 3] = 1.0, 1.0
+            bases[key] = bin_change((unit, zero), None)
+        bases[key] = bases.pop(key)  # the latest edited last
+        step = (new[m, :3] - old[m, :3]).astype(np.float64)
+        first[lights] += bases[key][0][lights] * step
+        lost[lights] += bases[key][1][lights] * step
+    metals = changed & (new[:, 3] != 0)
+    if metals.any():
+        change = bin_change((new, np.column_stack([old[:, :3], metals])), lights)
+        first, lost = first + change[0], lost + change[1]
+    return first, lost
+
+
+def _bin(ctx, programs, maps, shadows, materials, t, grid, budget, groups, lights=None, change=None) -> tuple:
+    """One cascade's records (gather.rsm_records: of `lights`, or the change of colours `change`) binned per light
+    into its clusters: (first (groups, C, 3), lost (groups, 3))."""
+    records = gather.rsm_records(ctx, programs, maps, shadows, materials, grid, budget, clusters.TEXEL_RECORDS,
+                                 unit_color=True, lights=lights, change=change)[0]
+    return clusters.bin_flux(t.clusters, records, t.cells, t.normals, groups=groups, axis=t.axis)
 
 
 def _transfer_geometry(frame, grids, k_grids, budget) -> tuple:

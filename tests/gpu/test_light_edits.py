@@ -37,23 +37,6 @@ def scene(lights):
     return s
 
 
-@pytest.fixture(scope="module")
-def engines():
-    from bounce_gi.gpu_kernels.engine import Engine
-    from bounce_gi.gpu_kernels.gl.context import GpuUnavailableError
-
-    warm, cold = Engine(), Engine()
-    try:
-        warm.gl_info()
-    except GpuUnavailableError as exc:
-        warm.shutdown()
-        cold.shutdown()
-        pytest.skip(str(exc))
-    yield warm, cold
-    warm.shutdown()
-    cold.shutdown()
-
-
 def test_moving_one_light_redraws_only_its_work_and_matches_a_cold_render(engines):
     from bounce_gi.gpu_kernels.settings import RenderSettings
 

@@ -7,6 +7,7 @@
 // first bounce (lpv/gather.glsl).
 #include "common/lights.glsl"
 #include "common/light_eval.glsl"
+#include "common/principled.glsl"
 #include "lpv/fixed.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -18,6 +19,13 @@ uniform int u_downsample;         // k: each k×k block of texels becomes one VP
 uniform vec3 u_grid_origin;
 uniform float u_grid_cell;
 uniform ivec3 u_grid_size;
+uniform sampler2D u_material_lut;  // common/principled.py: material_lut
+// Per material: rgb the base colour the RSM's texel colour is multiplied by (1 where a texture gives it), w unused
+// (direct/geometry.MaterialTextures.colors). With u_delta, the texels' flux is what a colour edit adds: their albedo
+// at these colours less at u_old_colors' (w > 0: the material's colour changed; the other texels add nothing).
+layout(std430, binding = 8) readonly buffer BaseColors { vec4 base_colors[]; };
+layout(std430, binding = 10) readonly buffer OldColors { vec4 old_colors[]; };
+uniform bool u_delta;
 
 struct RsmView {
     vec4 params;   // x: tan(half fov) (perspective) or 0; y: texel world size (orthographic); z: light; w: sample k
@@ -115,10 +123,40 @@ vec3 vpl_flux(RsmView v, vec3 p, vec3 n, vec3 albedo) {
     return albedo * color * psa * share_k * texel_solid_angle(v, p) * cube_share(v, p) / wsum;
 }
 
+// What a texel reflects of light from the light's direction (RSM normal.w = μ = n·l): Cycles' Diffuse and Glossy
+// Color at μ, by reciprocity; a VPL has no lobe, so the glossy part leaves diffusely, as in the voxels
+// (voxel/common.glsl voxel_albedo). `surface`: the RSM's texture colour and material index.
+vec3 texel_albedo(vec4 surface, float mu, vec3 color) {
+    int m = int(surface.w + 0.5);
+    vec3 base = surface.rgb * color;
+    return base * principled_diffuse(u_material_lut, m, mu) + principled_glossy(u_material_lut, m, mu, base);
+}
+
+// The albedo a texel's flux per unit albedo is multiplied by: its albedo, or with u_delta its colour edit's change.
+vec3 flux_albedo(vec4 surface, float mu) {
+    int m = int(surface.w + 0.5);
+    vec3 now = texel_albedo(surface, mu, base_colors[m].rgb);
+    if (!u_delta) return now;
+    return old_colors[m].w > 0.5 ? now - texel_albedo(surface, mu, old_colors[m].rgb) : vec3(0.0);
+}
+
+// Whether a lit texel of the block is of a material whose colour changed: with u_delta, only those blocks have
+// records that change.
+bool block_recolored(ivec2 block) {
+    for (int j = 0; j < u_downsample; ++j)
+        for (int i = 0; i < u_downsample; ++i) {
+            ivec2 px = block * u_downsample + ivec2(i, j);
+            if (texelFetch(u_rsm_position, px, 0).w >= 0.5 &&
+                old_colors[int(texelFetch(u_rsm_albedo, px, 0).w + 0.5)].w > 0.5) return true;
+        }
+    return false;
+}
+
 void main() {
     // Intensity-aware clustering (Kaplanyan 2009, §N.5.2): a k×k block of RSM texels becomes a VPL with the block's
-    // total flux, at the luminance-weighted mean position and normal — flux is kept exactly, and the VPL sits where the
-    // light is. A block can span two surfaces (a sunlit roof and, through its opening, the floor 3 m below): their
+    // total flux, at the mean position and normal weighted by the luminance of its flux per unit albedo — flux is kept
+    // exactly, and the VPL sits where the light is. (Not by the flux itself: then a material's colour would move the
+    // VPLs, and a colour edit could not re-bin the edited texels' change alone into the clusters the records went to.) A block can span two surfaces (a sunlit roof and, through its opening, the floor 3 m below): their
     // mean would float in the air between them, so texels off the plane of the block's first lit texel (normal
     // more than ~25° away, or more than half a cell from its plane) form a second VPL. Blocks never straddle views:
     // tiles are multiples of 16 texels and k divides 16.
@@ -129,6 +167,7 @@ void main() {
     ivec2 block = ivec2(gl_GlobalInvocationID.xy);
 #endif
     if (any(greaterThanEqual(block * u_downsample, u_rsm_size))) return;
+    if (u_delta && !block_recolored(block)) return;
     vec3 flux[2] = vec3[2](vec3(0.0), vec3(0.0));
     vec3 position[2] = vec3[2](vec3(0.0), vec3(0.0));
     vec3 normal[2] = vec3[2](vec3(0.0), vec3(0.0));
@@ -141,7 +180,8 @@ void main() {
             ivec2 px = block * u_downsample + ivec2(i, j);
             vec4 pos = texelFetch(u_rsm_position, px, 0);
             if (pos.w < 0.5) continue;
-            vec3 n = normalize(texelFetch(u_rsm_normal, px, 0).xyz);
+            vec4 normal_mu = texelFetch(u_rsm_normal, px, 0);
+            vec3 n = normalize(normal_mu.xyz);
             if (!has_plane) {
                 has_plane = true;
                 plane_p = pos.xyz;
@@ -152,9 +192,9 @@ void main() {
 #endif
             }
             int c = (dot(n, plane_n) > 0.9 && abs(dot(pos.xyz - plane_p, plane_n)) < 0.5 * u_grid_cell) ? 0 : 1;
-            vec3 f = vpl_flux(rsm_views[int(pos.w - 0.5)], pos.xyz, n, texelFetch(u_rsm_albedo, px, 0).rgb);
-            float w = dot(f, vec3(0.2126, 0.7152, 0.0722));  // Rec.709 luminance
-            flux[c] += f;
+            vec3 unit = vpl_flux(rsm_views[int(pos.w - 0.5)], pos.xyz, n, vec3(1.0));
+            float w = dot(unit, vec3(0.2126, 0.7152, 0.0722));  // Rec.709 luminance
+            flux[c] += unit * flux_albedo(texelFetch(u_rsm_albedo, px, 0), normal_mu.w);
             position[c] += w * pos.xyz;
             normal[c] += w * n;
             weight[c] += w;

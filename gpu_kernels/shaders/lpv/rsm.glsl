@@ -1,10 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Reflective shadow map (Dachsbacher and Stamminger 2005; Elvek 2012, §3.1): from one shadow view of a light, store the
-// surfels the light sees — world position (w = view index + 1), normal facing the light, albedo. The injection pass
-// turns each texel into a VPL whose flux it derives from these and the light's units. The albedo is what the surface
-// reflects of light from the light's direction: the diffuse base's share and the glossy layers' directional albedo
-// (Cycles' Diffuse and Glossy Color at μ = n·l, by reciprocity); a VPL has no lobe, so the glossy part leaves
-// diffusely, as in the voxels (voxel/common.glsl voxel_albedo).
+// surfels the light sees — world position (w = view index + 1), normal facing the light (w = μ = n·l), and what the
+// injection needs to compute their albedo (lpv/inject.glsl texel_albedo): the texture's colour where the material
+// has one (else 1) and the material's index. Not the albedo itself: the RSM then holds no material colour, so a
+// colour edit redraws no view, and the injection re-bins only the light the edited material's texels reflect.
 #if defined(VERTEX_SHADER)
 #include "common/surface_vertex.glsl"
 #endif
@@ -24,8 +23,8 @@ uniform float u_view_index;
 // and a rug lying 1 mm over a floor z-fought with it, the floor's colour showing through in patches.
 uniform float u_far;
 layout(location = 0) out vec4 out_position;  // xyz world position, w = view index + 1 (0: empty texel)
-layout(location = 1) out vec4 out_normal;    // xyz shading normal facing the light
-layout(location = 2) out vec4 out_albedo;    // rgb albedo (diffuse + glossy)
+layout(location = 1) out vec4 out_normal;    // xyz shading normal facing the light, w = μ = n·l
+layout(location = 2) out vec4 out_albedo;    // rgb the base colour texture's colour (1: none), w = material index
 
 void main() {
     vec3 to_light = u_ortho ? -u_forward : normalize(u_origin - v_position);
@@ -36,8 +35,7 @@ void main() {
     }
     gl_FragDepth = u_far > 0.0 ? length(v_position - u_origin) / u_far : gl_FragCoord.z;
     out_position = vec4(v_position, u_view_index + 1.0);
-    out_normal = vec4(n, 0.0);
-    float mu = max(dot(n, to_light), 0.0);
-    out_albedo = vec4(diffuse_albedo(v_uv, mu) + glossy_albedo(v_uv, mu), 0.0);
+    out_normal = vec4(n, max(dot(n, to_light), 0.0));
+    out_albedo = vec4(u_use_texture ? texture(u_base_texture, v_uv).rgb : vec3(1.0), float(u_material));
 }
 #endif
