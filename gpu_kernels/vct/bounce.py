@@ -22,7 +22,7 @@ def bounce(ctx, programs, vox, direct_faces: Faces, volumes: ConeVolumes, s: Vct
     faces carry after each bounce (bounce 1 = direct light reflected once)."""
     stats = [{"bounce": 1, "flux": direct_faces.flux}]
     gathered = s.bounces if not s.gathered_bounces else min(s.gathered_bounces, s.bounces)
-    if gathered <= 1:
+    if gathered <= 1 or _total(stats[0]) <= 0.0:  # one bounce, or no light reached a voxel: nothing to gather
         return ConeVolumes(volumes.textures, volumes.grid, volumes.levels, volumes.anisotropic, owned=False,
                            bounce_stats=stats, layers=volumes.layers, layers_owned=False)
     grid = direct_faces.grid
@@ -46,13 +46,35 @@ def bounce(ctx, programs, vox, direct_faces: Faces, volumes: ConeVolumes, s: Vct
         ctx.memory_barrier()
         own = source = build_volumes(ctx, programs, faces, volumes.anisotropic, into=own, layers=volumes.layers)
         stats.append({"bounce": b, "flux": face_flux(ctx, programs, faces)[0]})
-    if previous is not None:
+        if _total(stats[-1]) - _total(stats[-2]) < s.epsilon * _total(stats[0]):
+            stats[-1]["stopped"] = True  # the series ends here: no further gather, no tail
+            break
+    if previous is not None and stats[-1].get("stopped"):
+        if previous is not direct_faces:
+            previous.release()
+    elif previous is not None:
         stats.append(extrapolate_tail(ctx, programs, faces, previous, stats, s.bounces))
         if previous is not direct_faces:
             previous.release()
         own = build_volumes(ctx, programs, faces, volumes.anisotropic, into=own, layers=volumes.layers)
     own.faces, own.bounce_stats = faces, stats
     return own
+
+
+def _total(stat: dict) -> float:
+    """A bounce statistics row's flux, summed over RGB."""
+    return float(np.sum(stat["flux"]))
+
+
+def skipped_work(stats: list, s: VctSettings) -> list:
+    """What the scene let the bounce series leave out, in words (render --json "skipped_work", the panel)."""
+    if stats and _total(stats[0]) <= 0.0:
+        return ["bounces: no light reaches a voxel (no lights, or all off)"]
+    if stats and stats[-1].get("stopped") and stats[-1]["bounce"] < s.bounces:
+        b = stats[-1]["bounce"]
+        return [f"bounces {b + 1}-{s.bounces}: the series stopped after {b} (a bounce added less than epsilon = "
+                f"{s.epsilon:g} of the first)"]
+    return []
 
 
 def extrapolate_tail(ctx, programs, faces: Faces, previous: Faces, stats: list, bounces: int) -> dict:

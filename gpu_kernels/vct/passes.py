@@ -42,7 +42,8 @@ def run(frame) -> MethodOutput:
                                                                          bounced, s))
     indirect, k_trace, extra = _per_pixel(frame, faces, bounced, (frame.keys["gbuffer"], k_bounce,
                                                                           s.key("trace")))
-    info = {**trace.render_info(faces, bounced, s), "specular_pixels": glossy["traced"], **extra}
+    info = {**trace.render_info(faces, bounced, s), "specular_pixels": glossy["traced"], **extra,
+            "skipped_work": bounce.skipped_work(bounced.bounce_stats or [], s) + specular.skipped_work(glossy, s)}
     return MethodOutput(indirect, glossy["glossy"], (k_trace, k_spec), info, has_ao=True)
 
 

@@ -44,6 +44,9 @@ class VctSettings:
     # rel-L1, 64³, 9 cones everywhere): Cornell 0.093 vs 0.092, spot room 0.058 vs 0.056, courtyard 0.181 vs 0.180
     # in half the time (Cornell bounce pass 4.8 s vs 11.0 s on llvmpipe); gathering 3 was 0.098 / 0.057 / 0.198.
     gathered_bounces: int = 4
+    # Stop gathering once a bounce adds less than this fraction of the first bounce's flux (and extrapolate nothing
+    # after it): a dark scene's series ends early, reported in "skipped_work" (vct/bounce.py).
+    epsilon: float = 1e-3
     # Step / sampled voxel size of the volumetric march (Freed 2018, listing 4.1, steps by the cone radius): the bounce
     # gathers, the specular cone, isotropic volumes. The per-pixel sub-rays step one texel (vct/crossing.glsl).
     step_multiplier: float = 0.5
@@ -83,6 +86,7 @@ class VctSettings:
              f"diffuse_aperture {self.diffuse_aperture} must be 0 (derived) or in (0, 90) degrees"),
             (self.max_distance >= 0 and math.isfinite(self.max_distance), "max_distance must be ≥ 0 (0 = unlimited)"),
             (1 <= self.bounces <= 16, f"bounces {self.bounces} out of range 1..16"),
+            (0.0 <= self.epsilon < 1.0, f"epsilon {self.epsilon} out of range [0, 1)"),
             (self.gathered_bounces == 0 or 2 <= self.gathered_bounces <= 16,
              f"gathered_bounces {self.gathered_bounces} must be 0 (gather all) or 2..16 (the tail needs a ratio)"),
             (0.05 <= self.step_multiplier <= 2.0, f"step_multiplier {self.step_multiplier} out of range 0.05..2"),
@@ -100,7 +104,7 @@ class VctSettings:
     def key(self, kind: str) -> tuple:
         """The settings a pass reads: 'bounce', 'trace' (diffuse cones per pixel, upsampling, accumulation) or
         'specular' (resolution and anisotropy key the earlier passes)."""
-        extra = {"bounce": CONE_FIELDS + ("bounce_cones", "bounces", "gathered_bounces"),
+        extra = {"bounce": CONE_FIELDS + ("bounce_cones", "bounces", "gathered_bounces", "epsilon"),
                  "trace": CONE_FIELDS + ("subrays", "ao_distance", "indirect_scale", "cone_rotation",
                                          "temporal_frames"),
                  "specular": ("max_distance", "step_multiplier", "start_offset", "specular_cone",

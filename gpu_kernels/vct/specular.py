@@ -49,3 +49,13 @@ def specular(ctx, programs, gbuffer, faces: Faces, volumes: ConeVolumes, s: VctS
                         "u_camera_ortho": bool(gbuffer.ortho), "u_roughness_cutoff": float(s.roughness_cutoff)})
     out.bind_to_image(0, read=False, write=True)
     return {"glossy": out, "traced": dispatch_counted(ctx, prog, (w, h))}
+
+
+def skipped_work(result: dict, s: VctSettings) -> list:
+    """The specular cones left out, in words (render --json "skipped_work", the panel): all of them when the
+    setting is off or no pixel has a glossy closure smoother than the cutoff (Glossy Indirect is then 0)."""
+    if not s.specular_cone:
+        return ["specular cones: off (specular_cone)"]
+    if result["traced"] == 0:
+        return [f"specular cones: no pixel has a glossy closure smoother than roughness {s.roughness_cutoff:g}"]
+    return []
