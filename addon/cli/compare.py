@@ -3,6 +3,8 @@
 beside the reference's own noise floor, and optionally a heat map of the relative error."""
 from __future__ import annotations
 
+import math
+
 from ..scene_io import check_output_path, load_scene, progress, write_output
 from .options import parse_method_options, render_ours, vct_options
 
@@ -44,7 +46,10 @@ def format_compare(report: dict) -> str:
              f"({report['reference']['samples']} spp x 2 seeds, {report['reference']['bounces']} bounces)",
              f"{'pass':<18}{'rel-L1':>10}{'noise floor':>14}"]
     for key, value in report["rel_l1"].items():
-        lines.append(f"{key:<18}{value:>10.4f}{report['noise_floor'][key]:>14.4f}")
+        if math.isnan(value):  # rel-L1 divides by Cycles' pass, which is black over every compared pixel
+            lines.append(f"{key:<18}{'—':>10}{'—':>14}   (Cycles' pass is 0 where both hit geometry)")
+        else:
+            lines.append(f"{key:<18}{value:>10.4f}{report['noise_floor'][key]:>14.4f}")
     lines.append(f"relMSE (Combined) {report['rel_mse']:.5f}; Diffuse Color match {report['diffuse_color_match']:.2%}")
     s = report["seconds"]
     lines.append(f"time: ours {s['ours'] * 1000:.1f} ms; Cycles {s['cycles']:.2f} s"
