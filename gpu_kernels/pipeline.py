@@ -124,6 +124,12 @@ def indirect_image(out, shape) -> np.ndarray:
     return read_texture(out.indirect, 3)[::-1]
 
 
+def unlit(frame) -> bool:
+    """Whether nothing lights the scene: no light records (lamps without power or unable to reach it are left out,
+    emissive meshes and a world with colour are lights: common/lights.py)."""
+    return len(frame.shadows.buffers.lights) == 0
+
+
 def method_info(out, frame) -> dict:
     """The method's details (RenderResult.info), with "skipped_work": the lights that cannot light the scene and
     what the method left out."""
@@ -132,6 +138,9 @@ def method_info(out, frame) -> dict:
     info["skipped_work"] = lights + list(info.get("skipped_work", []))
     if out is None and frame.settings.method == "none":
         info["skipped_work"].append("indirect light: method none")
+    elif out is None:
+        info["skipped_work"].append("indirect light: nothing lights the scene (no lamp with power, no emission, a "
+                                    "black world), so no GI pass ran")
     return info
 
 
@@ -157,8 +166,7 @@ class Pipeline:
         self.cache.begin_frame()
         frame = self._direct_passes(scene, settings)
         direct_tex = self._direct_light(frame, frame.textures.lut)
-        method = METHOD_PASSES.get(settings.method)
-        out = method(frame) if method else None
+        out = self._method_output(frame)
 
         def compose():
             indirect = None if out is None or out.indirect is None else read_texture(out.indirect, 4)
@@ -238,8 +246,10 @@ class Pipeline:
 
     @staticmethod
     def _method_output(frame):
+        """The method's passes, or None: method "none", or a scene with no light at all (no lamp with power, no
+        emission, a black world), whose indirect light is 0 without them (method_info says which)."""
         method = METHOD_PASSES.get(frame.settings.method)
-        return method(frame) if method else None
+        return method(frame) if method and not unlit(frame) else None
 
     def _direct_passes(self, scene: Scene, settings: RenderSettings, samples: sgb.Samples | None = None) -> FrameInputs:
         """The passes every method shares, up to the G-buffer and the shadow maps, and the keys they ran under.

@@ -269,7 +269,7 @@ def skipped_work(stats: list, s) -> list:
     for c in stats[:1]:  # the cascades skip alike
         if c["injected_flux"] == 0:
             out.append("first bounce: no light reaches a surface the transport sees (no lights, or all off)")
-        if c["bounces_used"] < s.bounces:
+        elif c["bounces_used"] < s.bounces:
             out.append(f"bounces {c['bounces_used'] + 1}-{s.bounces}: the series stopped after {c['bounces_used']} "
                        f"(a bounce added less than epsilon = {s.epsilon:g} of the largest)")
     return out

@@ -26,11 +26,17 @@ def light_passes(result):
 @pytest.mark.parametrize("method", ALL)
 @pytest.mark.parametrize("kind", ("no lights", "zero power", "black light"))
 def test_no_light_is_black(engine, method, kind):
+    """Black, and with nothing to light it (no lamp with power, no emission, a black world) no GI pass runs: the
+    method's passes are skipped and skipped_work says why."""
     lamp = light("POINT", 0.0 if kind == "zero power" else 100.0, LIGHT_AT)
     if kind == "black light":
         lamp = replace(lamp, color=(0.0, 0.0, 0.0))
     scene = box_room(lights=[] if kind == "no lights" else [lamp])
-    assert all(p.max() == 0.0 for p in light_passes(render(engine, scene, method)))
+    result = render(engine, scene, method)
+    assert all(p.max() == 0.0 for p in light_passes(result))
+    assert not any(name.startswith(("lpv_", "vct_", "geometry_volume", "rsm")) for name in result.timings)
+    if method != "none":
+        assert any("nothing lights the scene" in w for w in result.info["skipped_work"])
 
 
 SHAPES = {"square": {"shape": "SQUARE"}, "rectangle": {"shape": "RECTANGLE"}, "disk": {"shape": "DISK"},
