@@ -9,8 +9,8 @@ Passes and their inputs (a pass re-runs only when one of its inputs changed — 
                     the camera, world
       shadow_depth← geometry, the shadow views (their depth atlas: a light's power or the world's colour
                     moves no view, so it is kept)
-      light_sources← geometry, emission, shadow settings, the closed emitters (the emissive meshes' lights and
-                    the sky's views: common/lights.static_lights)
+      light_sources← the emissive triangles, the scene's bounds, shadow settings, the closed emitters (the emissive
+                    meshes' lights and the sky's views: common/lights.static_lights; an object move keeps them)
     gbuffer       ← geometry, materials, camera, resolution
     sky_visibility← geometry, shading, camera, the sky's shadow views (its visible shares: a world colour edit or
                     another light's move keeps them)
@@ -32,6 +32,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from .common import emitters as em
+from .common import lights as lb
 from .compose import compose_passes
 from .direct import gbuffer as gb
 from .direct import geometry as geo
@@ -278,7 +279,7 @@ class Pipeline:
             ctx, programs, scene, geometry, settings.shadow, trapping,
             depth_pass=lambda key, render: cache.run("shadow_depth", (keys["geometry"], key), lambda: render(
                 cache.prior("shadow_depth", lambda k: k[0] == keys["geometry"]))),
-            static_pass=lambda make: cache.run("light_sources", (keys["geometry"], keys["emission"],
+            static_pass=lambda make: cache.run("light_sources", (lb.static_key(scene, trapping), keys["emission"],
                                                                  repr(settings.shadow), around), make)))
         keys["gbuffer"] = (keys["geometry"], keys["materials"], keys["camera"])
         if samples is None:

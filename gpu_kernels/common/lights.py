@@ -28,7 +28,7 @@ import numpy as np
 
 from . import camera as cam
 from . import emitters as em
-from ..scene import Light, Scene
+from ..scene import Light, Scene, hash_parts
 
 LIGHT_SUN, LIGHT_POINT, LIGHT_SPOT, LIGHT_POLYGON, LIGHT_SKY = 0, 1, 2, 3, 4
 # VCT's voxel injection (vct/inject.py) shadows the sky from every SKY_INJECTION_STRIDE-th direction, pixels from all:
@@ -244,6 +244,14 @@ class StaticLights:
     arguments of their records) and the sky's shadow views. A pipeline keeps them across light and world edits."""
     emitters: list  # (args, kwargs) of _Records.add
     sky_views: list  # ShadowView per sky direction
+
+
+def static_key(scene: Scene, trapping: list) -> str:
+    """What static_lights reads of `scene` beside the settings: the emissive triangles and their radiance, the
+    trapping shells' triangles and the scene's bounding sphere (the sky's views span it, the emitters' cubes reach
+    across it). Moving an object that emits nothing within the bounds keeps it."""
+    idx, radiance = em.emissive_triangles(scene)
+    return hash_parts(scene.positions[idx], radiance, [scene.positions[s] for s in trapping], *_scene_radius(scene))
 
 
 def static_lights(scene: Scene, settings: ShadowSettings | None = None, trapping: list | None = None) -> StaticLights:

@@ -70,3 +70,28 @@ def test_moving_one_light_redraws_only_its_work_and_matches_a_cold_render(engine
         cold.clear_cache()
         for name in PASSES:
             np.testing.assert_array_equal(result.passes[name], fresh.passes[name], err_msg=name)
+
+
+def test_moving_an_object_keeps_the_emitters_and_sky_views_while_the_bounds_hold(engines):
+    """The sky's shadow views and the emitters' lights (light_sources) depend on the emissive triangles and the
+    scene's bounds (common/lights.static_key), not on where a non-emitting object stands inside them: moving the box
+    keeps them, and Diffuse Direct is still exactly a cold render's; lifting it above everything else grows the
+    bounds, and they are made again."""
+    from bounce_gi.gpu_kernels.settings import RenderSettings
+
+    warm, cold = engines
+    settings = RenderSettings(method="none", width=96, height=72, shadow=ShadowSettings(
+        cube_resolution=128, sky_directions=64, sky_resolution=64))
+    lights = [point("a", -2.0, -1.0, 3.0)]
+    base = scene(lights)
+    warm.render(base, settings)
+    for lift, kept in ((0.0, True), (4.0, False)):
+        moved = scene(lights)
+        box = moved.material_index == 1
+        moved.positions = moved.positions.copy()
+        moved.positions[box] += np.float32([0.3, 0.2, lift])
+        result = warm.render(moved, settings)
+        assert ("light_sources" in result.skipped) == kept and "shadow_depth" not in result.skipped
+        fresh = cold.render(moved, settings)
+        cold.clear_cache()
+        np.testing.assert_array_equal(result.passes["Diffuse Direct"], fresh.passes["Diffuse Direct"])
