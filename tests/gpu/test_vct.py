@@ -303,30 +303,6 @@ def test_passes_rerun_only_downstream_and_ao_is_sky_visibility(engine, furnace):
     assert float(ao[hit].mean()) < 0.08 and float(ao[hit].max()) < 0.2
 
 
-def _dark_room(albedo, roughness):
-    """_sunlit_room with every surface a Principled BSDF of one albedo and roughness."""
-    scene = _sunlit_room()
-    scene.materials = [Material(m.name, (albedo,) * 3, roughness=roughness, specular_layer=True)
-                       for m in scene.materials]
-    return scene
-
-
-def test_the_bounce_series_stops_where_a_bounce_adds_less_than_epsilon_and_says_so(engine):
-    """Albedo 0.05: the second bounce adds about 0.05 × (the share of the first that reaches a surface) of the
-    first, under epsilon 0.05, so the series stops after it (no gather, no tail) and skipped_work says so; at albedo
-    0.7 every bounce adds more than that and all four are gathered. All-rough materials run no specular cone, and
-    say so too."""
-    dark = _render(engine, _dark_room(0.05, roughness=1.0), epsilon=0.05)
-    bounces = dark.info["bounces"]
-    assert [b["bounce"] for b in bounces] == [1, 2] and bounces[-1]["stopped"]
-    work = " ".join(dark.info["skipped_work"])
-    assert "bounces 3-8: the series stopped after 2" in work and "specular cones: no pixel" in work
-    bright = _render(engine, _dark_room(0.7, roughness=0.3), epsilon=0.05)
-    assert [b["bounce"] for b in bright.info["bounces"]] == [1, 2, 3, 4, 8]
-    assert not any("bounces" in w for w in bright.info["skipped_work"])
-    assert not any("specular" in w for w in bright.info["skipped_work"])  # roughness 0.3 runs its cones
-
-
 # ------------------------------------------------------------------------------------ (d) settings and cones
 @pytest.mark.parametrize("bad", [dict(resolution=8), dict(resolution=1024), dict(diffuse_cones=4),
                                  dict(diffuse_cones=10), dict(diffuse_cones=12), dict(diffuse_cones=17),
