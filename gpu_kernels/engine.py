@@ -85,7 +85,7 @@ class Engine:
         return self.submit_render(scene, settings).result()
 
     def _render(self, ctx, scene, settings):
-        return self._ensure_pipeline(ctx).render(scene, settings)
+        return self._ensure_pipeline(ctx).render(scene, settings, checked=True)  # submit_render checked them
 
     def _render_surface(self, ctx, scene, settings, budget, indirect_budget):
         atlas = build_atlas(scene, budget)

@@ -161,8 +161,11 @@ class Pipeline:
         self.programs = ProgramCache(ctx)
         self.cache = PassCache(finish=ctx.finish, keep={**lpv_passes.KEEP, **vct_passes.KEEP})
 
-    def render(self, scene: Scene, settings: RenderSettings) -> RenderResult:
-        check_renderable(scene, settings)
+    def render(self, scene: Scene, settings: RenderSettings, checked: bool = False) -> RenderResult:
+        """`checked`: the caller ran settings.check_renderable on these (Engine.submit_render does, on its own
+        thread: an unchanged frame then costs its keys and little else)."""
+        if not checked:
+            check_renderable(scene, settings)
         start = time.perf_counter()
         self.cache.begin_frame()
         frame = self._direct_passes(scene, settings)

@@ -7,6 +7,7 @@ Everything here is in Blender's world space (metres, Z up) and Blender's units (
 from __future__ import annotations
 
 import hashlib
+from functools import lru_cache
 from dataclasses import dataclass, field, fields, is_dataclass, replace
 
 import numpy as np
@@ -198,12 +199,11 @@ def _hash_into(h, value) -> None:
         h.update(str((a.dtype.str, a.shape)).encode())
         h.update(a.tobytes())
     elif is_dataclass(value):
-        h.update(type(value).__name__.encode())
-        for f in fields(value):
-            if f.name == "warnings":
-                continue
-            h.update(f.name.encode())
-            _hash_into(h, getattr(value, f.name))
+        kind, names = _field_names(type(value))
+        h.update(kind)
+        for name, encoded in names:
+            h.update(encoded)
+            _hash_into(h, getattr(value, name))
     elif isinstance(value, (list, tuple)):
         h.update(b"[")
         for v in value:
@@ -213,3 +213,10 @@ def _hash_into(h, value) -> None:
         h.update(repr(round(value, 9)).encode())
     else:
         h.update(repr(value).encode())
+
+
+@lru_cache(maxsize=None)
+def _field_names(cls) -> tuple:
+    """A dataclass's name and its fields' (name, encoded name) but "warnings", as _hash_into feeds them: computed
+    once per class (fields() per instance was most of an unchanged frame's key hashing)."""
+    return cls.__name__.encode(), tuple((f.name, f.name.encode()) for f in fields(cls) if f.name != "warnings")

@@ -247,7 +247,8 @@ def _smaller_scale(scene: Scene, grid: Grid, scale_bits: int, reruns: int) -> in
 def scene_area(scene: Scene) -> float:
     """Total triangle area of the scene (m², float64)."""
     p = np.asarray(scene.positions, np.float64)
-    return float(0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1).sum())
+    c = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    return float(0.5 * np.sqrt(np.einsum("ij,ij->i", c, c)).sum())
 
 
 def material_maxima(scene: Scene, used, transport: np.ndarray) -> tuple[float, float]:
