@@ -11,7 +11,7 @@ APT_PACKAGES := libx11-6 libxi6 libxfixes3 libxrender1 libxkbcommon0 libsm6 libi
                 libegl1 libegl-mesa0 libgl1-mesa-dri
 STAMP := $(VENV)/.setup-done
 
-.PHONY: setup demo test test-fast bench package clean system-libs
+.PHONY: setup demo test test-fast bench bench-edits package clean system-libs
 
 setup: $(STAMP)
 
@@ -54,6 +54,15 @@ bench: setup
 	$(VENV)/bin/bounce-gi bench $(BENCH_SCENES:%=out/ex/%.blend) --incremental --res 160 120 --out $(BENCH_OUT)
 	$(VENV)/bin/bounce-gi bench --scaling > $(BENCH_OUT)/scaling.md
 	cp $(BENCH_OUT)/quality_front.json addon/quality_front.json
+
+# What an edit costs on every example scene, LPV (about 15 min here): benchmarks/results/<renderer>/incremental_run.md,
+# the tables incremental.md's notes are written from.
+EDIT_SCENES = $(BENCH_SCENES) default_principled metals textured window_room rug_room thin_walls lamp_room \
+	many_lights outdoor product_shot furnished cornell_animated
+bench-edits: setup
+	$(PY) examples/build_examples.py out/ex $(EDIT_SCENES)
+	$(VENV)/bin/bounce-gi bench $(EDIT_SCENES:%=out/ex/%.blend) --incremental --methods lpv --res 160 120 \
+		--out $(BENCH_OUT)
 
 package: setup
 	$(PY) tools/package.py

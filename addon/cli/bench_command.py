@@ -29,14 +29,17 @@ def cmd_bench(args) -> dict:
     return report
 
 
+INCREMENTAL_FILE = "incremental_run.md"  # what `bench --incremental --out DIR` writes in DIR
+
+
 def bench_incremental(args) -> dict:
     paths = [check_blend_path(p) for p in args.scenes]
     report = {"incremental": [run_incremental(p, args.res, tuple(args.methods), progress,
                                               1 if args.quick else 3) for p in paths]}
-    if args.out:
+    if args.out:  # this run's tables; the results folder's incremental.md is the written-up history beside them
         text = "".join(format_incremental(e) for e in report["incremental"])
         write_output(lambda path, t: open(path, "w").write(t),
-                     os.path.join(check_out_dir(args.out), "incremental.md"), text)
+                     os.path.join(check_out_dir(args.out), INCREMENTAL_FILE), text)
     if not args.json:
         print("".join(format_incremental(e) for e in report["incremental"]))
     return report
