@@ -7,8 +7,8 @@ Everything here is in Blender's world space (metres, Z up) and Blender's units (
 from __future__ import annotations
 
 import hashlib
-from functools import lru_cache
 from dataclasses import dataclass, field, fields, is_dataclass, replace
+from functools import lru_cache
 
 import numpy as np
 
