@@ -8,7 +8,8 @@ Passes and their inputs (a pass re-runs only when one of its inputs changed — 
     shadow_maps   ← geometry, emission (emissive triangles), lights, shadow settings, which closed emitters hold
                     the camera, world
       shadow_depth← geometry, the shadow views (their depth atlas: a light's power or the world's colour
-                    moves no view, so it is kept)
+                    moves no view, so it is kept; a light's move redraws its tiles, an object's move the part of
+                    each tile it covers: direct/shadows.render_depth)
       light_sources← the emissive triangles, the scene's bounds, shadow settings, the closed emitters (the emissive
                     meshes' lights and the sky's views: common/lights.static_lights; an object move keeps them)
     gbuffer       ← geometry, materials, camera, resolution
@@ -277,11 +278,12 @@ class Pipeline:
                          around)
         # The depth atlas is a pass of its own, keyed by the views it draws: a light's power or colour and the
         # world's change the records, not the maps (576 of them for the sky). A light's move redraws its own maps
-        # into the kept atlas (direct/shadows.render_depth), not every light's.
+        # into the kept atlas (direct/shadows.render_depth), not every light's; an object's move, in every map, the
+        # rectangle its old and new places cover.
         shadows = cache.run("shadow_maps", keys["shadow"], lambda: sh.render_shadow_atlas(
             ctx, programs, scene, geometry, settings.shadow, trapping,
             depth_pass=lambda key, render: cache.run("shadow_depth", (keys["geometry"], key), lambda: render(
-                cache.prior("shadow_depth", lambda k: k[0] == keys["geometry"]))),
+                cache.prior("shadow_depth", lambda k: True))),  # render_depth redraws what moved in it
             static_pass=lambda make: cache.run("light_sources", (lb.static_key(scene, trapping), keys["emission"],
                                                                  repr(settings.shadow), around), make)))
         keys["gbuffer"] = (keys["geometry"], keys["materials"], keys["camera"])

@@ -71,7 +71,7 @@ def render_shadow_atlas(ctx, programs, scene: Scene, geometry: GeometryBuffers,
     rows = view_rows(buffers.views)
 
     def render(prior=None):
-        return render_depth(ctx, programs, geometry, buffers.views, tiles, size, prior, rows)
+        return render_depth(ctx, programs, geometry, buffers.views, tiles, size, prior, rows, scene.positions)
 
     key = depth_key(rows, tiles, size)
     depth = (render() if depth_pass is None else depth_pass(key, render)).texture
@@ -127,7 +127,9 @@ class DepthAtlas:
     tiles: list
     size: tuple
     views: np.ndarray
-    drawn: int = 0  # views drawn when it was last made or updated
+    drawn: int = 0  # views drawn (whole or in part) when it was last made or updated
+    positions: np.ndarray = None  # the scene's triangles it was drawn from (Scene.positions)
+    partial: int = 0  # of the views drawn, those drawn in a rectangle only (an object's move: moved_rect)
 
     def release(self):
         self.texture.release()
@@ -148,15 +150,21 @@ def views_to_redraw(prior, tiles: list, size: tuple, rows: np.ndarray) -> list |
 
 
 def render_depth(ctx, programs, geometry: GeometryBuffers, views: list, tiles: list, size: tuple,
-                 prior: DepthAtlas | None = None, rows: np.ndarray | None = None) -> DepthAtlas:
-    """The depth atlas: every view drawn into its tile (direct/shadow_depth.glsl). With `prior` (an atlas of the
-    same geometry, tiled alike) only the views that changed are drawn again, into `prior`, which is returned
-    updated: whoever held it sees the new maps (the pass cache, whose entry it then is). `rows`: view_rows(views)."""
+                 prior: DepthAtlas | None = None, rows: np.ndarray | None = None,
+                 positions: np.ndarray | None = None) -> DepthAtlas:
+    """The depth atlas: every view drawn into its tile (direct/shadow_depth.glsl). With `prior` (an atlas tiled
+    alike) only what changed is drawn again, into `prior`, which is returned updated: whoever held it sees the new
+    maps (the pass cache, whose entry it then is) — the tiles whose view changed (a light's move redraws that light's
+    maps), and where the scene's triangles (`positions`) moved since `prior` was drawn, in every other tile the
+    rectangle the moved triangles' box covers (moved_rect). `rows`: view_rows(views)."""
     import moderngl
 
     rows = view_rows(views) if rows is None else rows
     tiles, size = [tuple(t) for t in tiles], tuple(size)
-    redraw = views_to_redraw(prior, tiles, size, rows)
+    box = None if prior is None or positions is None else moved_box(prior.positions, positions)
+    redraw = None if box is False else views_to_redraw(prior, tiles, size, rows)
+    parts = [] if redraw is None or box is None else [
+        (i, moved_rect(views[i], box, tiles[i])) for i in sorted(set(range(len(views))) - set(redraw))]
     if redraw is not None:
         depth = prior.texture
     else:
@@ -164,7 +172,9 @@ def render_depth(ctx, programs, geometry: GeometryBuffers, views: list, tiles: l
         depth.compare_func = "<="
         depth.filter = (moderngl.LINEAR, moderngl.LINEAR)
         depth.repeat_x = depth.repeat_y = False
-    if views and redraw != []:
+    parts = [(i, rect) for i, rect in parts if rect is not None]
+    draws = [(i, None) for i in (range(len(views)) if redraw is None else redraw)] + parts
+    if draws:
         fbo = ctx.framebuffer(depth_attachment=depth)
         fbo.use()
         if redraw is None:
@@ -172,18 +182,54 @@ def render_depth(ctx, programs, geometry: GeometryBuffers, views: list, tiles: l
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.disable(moderngl.CULL_FACE)
         prog = programs.raster("direct/shadow_depth.glsl")
-        for i in range(len(views)) if redraw is None else redraw:
+        for i, rect in draws:
             view, tile = views[i], tiles[i]
             if redraw is not None:
-                fbo.clear(depth=1.0, viewport=tile)
+                fbo.clear(depth=1.0, viewport=rect or tile)
             fbo.viewport = tile
+            ctx.scissor = rect  # None: the whole tile
             write_uniform(prog, "u_view_projection", view.view_projection.T)
             set_uniform(prog, "u_origin", tuple(float(c) for c in view.origin))
             set_uniform(prog, "u_far", float(view.far))
             geometry.vao_depth.render(moderngl.TRIANGLES)
+        ctx.scissor = None
         fbo.release()
-    drawn = len(views) if redraw is None else len(redraw)
     if redraw is not None:
-        prior.views, prior.drawn = rows, drawn
+        prior.views, prior.drawn, prior.positions, prior.partial = rows, len(draws), positions, len(parts)
         return prior
-    return DepthAtlas(depth, tiles, size, rows, drawn)
+    return DepthAtlas(depth, tiles, size, rows, len(draws), positions)
+
+
+def moved_box(before: np.ndarray | None, after: np.ndarray):
+    """The world box (2, 3) of the triangles that differ between two (T, 3, 3) position arrays, before and after;
+    None where none does; False where they cannot be compared (another triangle count, or no record)."""
+    if before is None or before.shape != after.shape:
+        return False
+    if before is after:
+        return None
+    changed = np.any(before != after, axis=(1, 2))
+    if not changed.any():
+        return None
+    corners = np.concatenate([before[changed], after[changed]]).reshape(-1, 3).astype(np.float64)
+    return np.stack([corners.min(axis=0), corners.max(axis=0)])
+
+
+MOVED_MARGIN = 2  # texels around a moved box's projection (rasterisation rules at its edges; depth slope)
+
+
+def moved_rect(view, box: np.ndarray, tile: tuple):
+    """The rectangle (x, y, w, h) of `tile` that the world `box` can cover in `view` (its corners projected, grown by
+    MOVED_MARGIN texels, within the tile), None where it covers none, the whole tile where a corner lies behind a
+    perspective view's eye: the only texels a triangle inside the box can write."""
+    corners = np.array([[box[i][0], box[j][1], box[k][2], 1.0] for i in (0, 1) for j in (0, 1) for k in (0, 1)])
+    clip = corners @ np.asarray(view.view_projection, np.float64).T
+    if np.any(clip[:, 3] <= 1e-9 * np.abs(clip[:, :3]).max(initial=1.0)):
+        return tile
+    ndc = clip[:, :2] / clip[:, 3:4]
+    x, y, w, h = tile
+    lo = np.floor(np.array([x, y]) + (ndc.min(axis=0) * 0.5 + 0.5) * np.array([w, h])) - MOVED_MARGIN
+    hi = np.ceil(np.array([x, y]) + (ndc.max(axis=0) * 0.5 + 0.5) * np.array([w, h])) + MOVED_MARGIN
+    lo, hi = np.maximum(lo, [x, y]), np.minimum(hi, [x + w, y + h])
+    if np.any(hi <= lo):
+        return None
+    return int(lo[0]), int(lo[1]), int(hi[0] - lo[0]), int(hi[1] - lo[1])

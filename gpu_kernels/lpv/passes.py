@@ -47,8 +47,9 @@ def run(frame) -> MethodOutput:
     # The RSMs hold positions, normals, texture colours and material indices: they follow the lights' views, not
     # their colours nor the materials' (lpv/rsm.glsl).
     k_rsm = (frame.keys["geometry"], frame.keys["textures"], frame.shadows.views_key, s.rsm_resolution, texel)
-    # A light's move redraws its own views into the kept RSM of the same geometry and textures (render_rsm).
-    prior = cache.prior("rsm", lambda k: k[:2] == k_rsm[:2] and k[3:] == k_rsm[3:])
+    # A light's move redraws its own views into the kept RSM of the same textures, an object's move the part of
+    # every view it covers (render_rsm).
+    prior = cache.prior("rsm", lambda k: k[1] == k_rsm[1] and k[3:] == k_rsm[3:])
     maps = cache.run("rsm", k_rsm, lambda: rsm.render_rsm(ctx, programs, scene, frame.geometry, frame.textures,
                                                            frame.shadows, s.rsm_resolution, texel, prior))
     budget = transfer_budget(scene, grids, s)

@@ -11,7 +11,7 @@ import numpy as np
 from ..common import atlas
 from ..common import lights as lb
 from ..direct.geometry import draw_by_material
-from ..direct.shadows import views_to_redraw
+from ..direct.shadows import moved_box, moved_rect, views_to_redraw
 from ..gl.bind import set_uniform, ssbo, write_uniform
 from ..scene import Scene
 
@@ -29,7 +29,10 @@ class Rsm:
     depth: object = None
     tiles: list = None  # each view's tile (x, y, w, h)
     views: np.ndarray = None  # (N, 20) what each tile was drawn from (direct/shadows.view_rows)
-    drawn: int = 0  # views drawn when it was last made or updated
+    drawn: int = 0  # views drawn (whole or in part) when it was last made or updated
+    positions: np.ndarray = None  # the scene's triangles it was drawn from (Scene.positions)
+    geometry: object = None  # the GeometryBuffers `vao` draws
+    partial: int = 0  # of the views drawn, those drawn in a rectangle only (an object's move: moved_rect)
 
     def release(self):
         for obj in (self.position, self.normal, self.albedo, self.views_ssbo, self.fbo, self.depth, self.vao):
@@ -87,8 +90,9 @@ def render_rsm(ctx, programs, scene: Scene, geometry, textures, shadows, resolut
                prior: Rsm | None = None) -> Rsm:
     """Render every shadow view of every light once more as an RSM (position, normal, albedo) into an atlas.
     `texel` (m, > 0): the finest texel an orthographic view needs (view_resolution). With `prior` (the RSM of the
-    same geometry and materials) only the views that changed are drawn again, into `prior`, which is returned
-    updated (as direct/shadows.render_depth does with the depth atlas: a light's move redraws its own views)."""
+    same textures, tiled alike) only what changed is drawn again, into `prior`, which is returned updated, as
+    direct/shadows.render_depth does with the depth atlas: the views that changed (a light's move redraws its own),
+    and where the scene's triangles moved, in every other view the rectangle they cover (moved_rect)."""
     import moderngl
 
     buffers = shadows.buffers
@@ -97,9 +101,16 @@ def render_rsm(ctx, programs, scene: Scene, geometry, textures, shadows, resolut
            for v, light in zip(views, view_lights)]
     tiles, size, scale = atlas.allocate_atlas(res, max_height=ctx.info.get("GL_MAX_TEXTURE_SIZE", 16384))
     tiles, size, rows = [tuple(t) for t in tiles], tuple(size), shadows.rows
-    redraw = views_to_redraw(prior, tiles, size, rows)
+    box = None if prior is None else moved_box(prior.positions, scene.positions)
+    redraw = None if box is False else views_to_redraw(prior, tiles, size, rows)
     out = prior if redraw is not None else _new_rsm(ctx, programs, geometry, size, resolution // scale)
+    if out.geometry is not geometry:  # the geometry's buffers were made again: draw from the new ones
+        out.vao.release()
+        out.vao = _vertex_array(ctx, programs, geometry)
     redraw = None if redraw is None else set(redraw)
+    parts = {} if redraw is None or box is None else {
+        i: moved_rect(v, box, t) for i, (v, t) in enumerate(zip(views, tiles)) if i not in redraw}
+    parts = {i: rect for i, rect in parts.items() if rect is not None}
     out.fbo.use()
     if redraw is None:
         out.fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
@@ -109,11 +120,12 @@ def render_rsm(ctx, programs, scene: Scene, geometry, textures, shadows, resolut
     records = np.zeros(len(views), RSM_VIEW_DTYPE)
     for i, (view, (x, y, w, h)) in enumerate(zip(views, tiles)):
         _view_record(records[i], view, view_lights[i], buffers.lights[view_lights[i]], i, w)
-        if redraw is not None and i not in redraw:
+        if redraw is not None and i not in redraw and i not in parts:
             continue
         if redraw is not None:
-            out.fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0, viewport=(x, y, w, h))
+            out.fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0, viewport=parts.get(i, (x, y, w, h)))
         out.fbo.viewport = (x, y, w, h)
+        ctx.scissor = parts.get(i)  # None: the whole tile
         write_uniform(prog, "u_view_projection", view.view_projection.T)
         back = view.view_matrix[2, :3]  # rows of world → view: right, up, back
         set_uniform(prog, "u_origin", tuple(float(c) for c in view.origin))
@@ -122,13 +134,15 @@ def render_rsm(ctx, programs, scene: Scene, geometry, textures, shadows, resolut
         set_uniform(prog, "u_far", 0.0 if view.ortho else float(view.far))
         set_uniform(prog, "u_view_index", float(i))
         draw_by_material(prog, scene, geometry, textures, vao=out.vao)
+    ctx.scissor = None
     if out.views_ssbo is not None and out.views_ssbo.size == records.nbytes:
         out.views_ssbo.write(records.tobytes())
     else:
         if out.views_ssbo is not None:
             out.views_ssbo.release()
         out.views_ssbo = ssbo(ctx, records)
-    out.tiles, out.views, out.drawn = tiles, rows, len(views) if redraw is None else len(redraw)
+    out.tiles, out.views, out.drawn = tiles, rows, len(views) if redraw is None else len(redraw) + len(parts)
+    out.positions, out.geometry, out.partial = scene.positions, geometry, len(parts)
     return out
 
 
@@ -142,9 +156,14 @@ def _new_rsm(ctx, programs, geometry, size: tuple, resolution: int) -> Rsm:
         t.filter = (moderngl.NEAREST, moderngl.NEAREST)
     depth = ctx.depth_renderbuffer(size)
     fbo = ctx.framebuffer(color_attachments=targets, depth_attachment=depth)
+    return Rsm(*targets, None, size, resolution, _vertex_array(ctx, programs, geometry), fbo, depth,
+               geometry=geometry)
+
+
+def _vertex_array(ctx, programs, geometry):
+    """The VAO lpv/rsm.glsl draws `geometry`'s vertex buffer with."""
     prog = programs.raster("lpv/rsm.glsl")
-    vao = ctx.vertex_array(prog, [(geometry.vbo, "3f 3f 2f 3f", "in_position", "in_normal", "in_uv", "in_geo_normal")])
-    return Rsm(*targets, None, size, resolution, vao, fbo, depth)
+    return ctx.vertex_array(prog, [(geometry.vbo, "3f 3f 2f 3f", "in_position", "in_normal", "in_uv", "in_geo_normal")])
 
 
 def _view_record(record, view, light: int, light_record, index: int, w: int) -> None:

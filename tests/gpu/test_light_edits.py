@@ -72,15 +72,27 @@ def test_moving_one_light_redraws_only_its_work_and_matches_a_cold_render(engine
             np.testing.assert_array_equal(result.passes[name], fresh.passes[name], err_msg=name)
 
 
-def test_moving_an_object_keeps_the_emitters_and_sky_views_while_the_bounds_hold(engines):
+def _maps(engine, method) -> list:
+    """The engine's shadow depth atlas and, for the LPV, its RSM's targets, read back."""
+    entries = engine.pipeline.cache.entries
+    textures = [entries["shadow_depth"].value.texture]
+    if method == "lpv":
+        rsm = entries["rsm"].value
+        textures += [rsm.position, rsm.normal, rsm.albedo]
+    return engine.worker.call(lambda _ctx: [np.frombuffer(t.read(), np.float32).copy() for t in textures])
+
+
+@pytest.mark.parametrize("method", ["none", "lpv"])
+def test_moving_an_object_keeps_the_emitters_and_sky_views_while_the_bounds_hold(engines, method):
     """The sky's shadow views and the emitters' lights (light_sources) depend on the emissive triangles and the
     scene's bounds (common/lights.static_key), not on where a non-emitting object stands inside them: moving the box
-    keeps them, and Diffuse Direct is still exactly a cold render's; lifting it above everything else grows the
-    bounds, and they are made again."""
+    keeps them, redraws in each depth map and RSM view only the rectangle the box's old and new places cover
+    (direct/shadows.moved_rect), and the maps and Diffuse Direct are still exactly a cold render's; lifting it
+    above everything else grows the bounds, and they are made again."""
     from bounce_gi.gpu_kernels.settings import RenderSettings
 
     warm, cold = engines
-    settings = RenderSettings(method="none", width=96, height=72, shadow=ShadowSettings(
+    settings = RenderSettings(method=method, width=96, height=72, shadow=ShadowSettings(
         cube_resolution=128, sky_directions=64, sky_resolution=64))
     lights = [point("a", -2.0, -1.0, 3.0)]
     base = scene(lights)
@@ -92,6 +104,11 @@ def test_moving_an_object_keeps_the_emitters_and_sky_views_while_the_bounds_hold
         moved.positions[box] += np.float32([0.3, 0.2, lift])
         result = warm.render(moved, settings)
         assert ("light_sources" in result.skipped) == kept and "shadow_depth" not in result.skipped
+        entries = warm.pipeline.cache.entries
+        partial = [entries[name].value.partial for name in ("shadow_depth", "rsm")[:2 if method == "lpv" else 1]]
+        assert all((p > 0) == kept for p in partial)  # grown bounds move every sky view: each is drawn whole
         fresh = cold.render(moved, settings)
+        for a, b in zip(_maps(warm, method), _maps(cold, method)):
+            np.testing.assert_array_equal(a, b)
         cold.clear_cache()
         np.testing.assert_array_equal(result.passes["Diffuse Direct"], fresh.passes["Diffuse Direct"])
