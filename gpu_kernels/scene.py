@@ -159,10 +159,10 @@ def material_keys(scene: Scene) -> dict:
     of a surface beyond its position: the layers, and the base colour only where a metal's Fresnel takes it — a
     dielectric's base colour only tints the Diffuse Color that compose multiplies by). A base colour edit of a
     non-metal changes "materials" alone."""
-    layers = [replace(m, name="", emission=(0.0, 0.0, 0.0), base_color=(0.0, 0.0, 0.0)) for m in scene.materials]
     metals = [i for i, m in enumerate(scene.materials) if m.metallic != 0]
     textures = hash_parts([m.base_color_texture for m in scene.materials], scene.textures)
-    layers = hash_parts(layers)
+    layers = hash_parts([replace(m, name="", emission=(0.0, 0.0, 0.0), base_color=(0.0, 0.0, 0.0))
+                         for m in scene.materials])
     return {"materials": hash_parts(scene.materials, textures), "textures": textures, "layers": layers,
             "emission": hash_parts([m.emission for m in scene.materials]),
             "shading": hash_parts(layers, [scene.materials[i].base_color for i in metals],

@@ -141,12 +141,23 @@ def view_rows(views: list) -> np.ndarray:
                     np.float64).reshape(len(views), 20)
 
 
-def views_to_redraw(prior, tiles: list, size: tuple, rows: np.ndarray) -> list | None:
-    """The indices of the views whose rows (view_rows) differ from those `prior` (a DepthAtlas or an RSM, with
-    .tiles, .size and .views) was drawn from, or None where `prior` cannot be updated: none, or tiled otherwise."""
+def redraw_plan(prior, views: list, tiles: list, size: tuple, rows: np.ndarray, positions: np.ndarray | None):
+    """What to draw again into `prior` (a DepthAtlas or an RSM, with .tiles, .size, .views and .positions) for
+    `views` in `tiles` of an atlas of `size`: (i, rect) per view — rect None for the whole tile, where the view's
+    rows (view_rows) changed; else, where the scene's triangles (`positions`) moved since `prior` was drawn, the
+    rectangle they can cover (moved_rect). None where `prior` cannot be updated (none, tiled otherwise, another
+    triangle count): draw everything."""
     if prior is None or prior.tiles != tiles or prior.size != size:
         return None
-    return np.nonzero(np.any(rows != prior.views, axis=1))[0].tolist()
+    box = None if positions is None else moved_box(prior.positions, positions)
+    if box is False:
+        return None
+    whole = np.any(rows != prior.views, axis=1)
+    plan = [(int(i), None) for i in np.nonzero(whole)[0]]
+    if box is not None:
+        rects = [(i, moved_rect(views[i], box, tiles[i])) for i in np.nonzero(~whole)[0]]
+        plan += [(int(i), rect) for i, rect in rects if rect is not None]
+    return plan
 
 
 def render_depth(ctx, programs, geometry: GeometryBuffers, views: list, tiles: list, size: tuple,
@@ -161,30 +172,26 @@ def render_depth(ctx, programs, geometry: GeometryBuffers, views: list, tiles: l
 
     rows = view_rows(views) if rows is None else rows
     tiles, size = [tuple(t) for t in tiles], tuple(size)
-    box = None if prior is None or positions is None else moved_box(prior.positions, positions)
-    redraw = None if box is False else views_to_redraw(prior, tiles, size, rows)
-    parts = [] if redraw is None or box is None else [
-        (i, moved_rect(views[i], box, tiles[i])) for i in sorted(set(range(len(views))) - set(redraw))]
-    if redraw is not None:
+    plan = redraw_plan(prior, views, tiles, size, rows, positions)
+    if plan is not None:
         depth = prior.texture
     else:
         depth = ctx.depth_texture(size)
         depth.compare_func = "<="
         depth.filter = (moderngl.LINEAR, moderngl.LINEAR)
         depth.repeat_x = depth.repeat_y = False
-    parts = [(i, rect) for i, rect in parts if rect is not None]
-    draws = [(i, None) for i in (range(len(views)) if redraw is None else redraw)] + parts
+    draws = [(i, None) for i in range(len(views))] if plan is None else plan
     if draws:
         fbo = ctx.framebuffer(depth_attachment=depth)
         fbo.use()
-        if redraw is None:
+        if plan is None:
             fbo.clear(depth=1.0)
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.disable(moderngl.CULL_FACE)
         prog = programs.raster("direct/shadow_depth.glsl")
         for i, rect in draws:
             view, tile = views[i], tiles[i]
-            if redraw is not None:
+            if plan is not None:
                 fbo.clear(depth=1.0, viewport=rect or tile)
             fbo.viewport = tile
             ctx.scissor = rect  # None: the whole tile
@@ -194,8 +201,9 @@ def render_depth(ctx, programs, geometry: GeometryBuffers, views: list, tiles: l
             geometry.vao_depth.render(moderngl.TRIANGLES)
         ctx.scissor = None
         fbo.release()
-    if redraw is not None:
-        prior.views, prior.drawn, prior.positions, prior.partial = rows, len(draws), positions, len(parts)
+    partial = sum(rect is not None for _, rect in draws)
+    if plan is not None:
+        prior.views, prior.drawn, prior.positions, prior.partial = rows, len(draws), positions, partial
         return prior
     return DepthAtlas(depth, tiles, size, rows, len(draws), positions)
 

@@ -11,7 +11,7 @@ import numpy as np
 from ..common import atlas
 from ..common import lights as lb
 from ..direct.geometry import draw_by_material
-from ..direct.shadows import moved_box, moved_rect, views_to_redraw
+from ..direct.shadows import redraw_plan
 from ..gl.bind import set_uniform, ssbo, write_uniform
 from ..scene import Scene
 
@@ -101,18 +101,14 @@ def render_rsm(ctx, programs, scene: Scene, geometry, textures, shadows, resolut
            for v, light in zip(views, view_lights)]
     tiles, size, scale = atlas.allocate_atlas(res, max_height=ctx.info.get("GL_MAX_TEXTURE_SIZE", 16384))
     tiles, size, rows = [tuple(t) for t in tiles], tuple(size), shadows.rows
-    box = None if prior is None else moved_box(prior.positions, scene.positions)
-    redraw = None if box is False else views_to_redraw(prior, tiles, size, rows)
-    out = prior if redraw is not None else _new_rsm(ctx, programs, geometry, size, resolution // scale)
+    plan = redraw_plan(prior, views, tiles, size, rows, scene.positions)
+    out = prior if plan is not None else _new_rsm(ctx, programs, geometry, size, resolution // scale)
     if out.geometry is not geometry:  # the geometry's buffers were made again: draw from the new ones
         out.vao.release()
         out.vao = _vertex_array(ctx, programs, geometry)
-    redraw = None if redraw is None else set(redraw)
-    parts = {} if redraw is None or box is None else {
-        i: moved_rect(v, box, t) for i, (v, t) in enumerate(zip(views, tiles)) if i not in redraw}
-    parts = {i: rect for i, rect in parts.items() if rect is not None}
+    draws = {i: None for i in range(len(views))} if plan is None else dict(plan)
     out.fbo.use()
-    if redraw is None:
+    if plan is None:
         out.fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
     ctx.enable(moderngl.DEPTH_TEST)
     ctx.disable(moderngl.CULL_FACE)
@@ -120,12 +116,12 @@ def render_rsm(ctx, programs, scene: Scene, geometry, textures, shadows, resolut
     records = np.zeros(len(views), RSM_VIEW_DTYPE)
     for i, (view, (x, y, w, h)) in enumerate(zip(views, tiles)):
         _view_record(records[i], view, view_lights[i], buffers.lights[view_lights[i]], i, w)
-        if redraw is not None and i not in redraw and i not in parts:
+        if i not in draws:
             continue
-        if redraw is not None:
-            out.fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0, viewport=parts.get(i, (x, y, w, h)))
+        if plan is not None:
+            out.fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0, viewport=draws[i] or (x, y, w, h))
         out.fbo.viewport = (x, y, w, h)
-        ctx.scissor = parts.get(i)  # None: the whole tile
+        ctx.scissor = draws[i]  # None: the whole tile
         write_uniform(prog, "u_view_projection", view.view_projection.T)
         back = view.view_matrix[2, :3]  # rows of world → view: right, up, back
         set_uniform(prog, "u_origin", tuple(float(c) for c in view.origin))
@@ -141,8 +137,8 @@ def render_rsm(ctx, programs, scene: Scene, geometry, textures, shadows, resolut
         if out.views_ssbo is not None:
             out.views_ssbo.release()
         out.views_ssbo = ssbo(ctx, records)
-    out.tiles, out.views, out.drawn = tiles, rows, len(views) if redraw is None else len(redraw) + len(parts)
-    out.positions, out.geometry, out.partial = scene.positions, geometry, len(parts)
+    out.tiles, out.views, out.drawn = tiles, rows, len(draws)
+    out.positions, out.geometry, out.partial = scene.positions, geometry, sum(r is not None for r in draws.values())
     return out
 
 
