@@ -27,7 +27,8 @@ import numpy as np
 
 from ..common.method import MethodOutput
 from ..voxel.voxelize import scene_area
-from . import clusters, gather, inject, lighting, occlusion, octree, propagate, receivers, rsm, transfer
+from . import (clusters, gather, inject, lighting, occlusion, octree, propagate, receivers, rsm, transfer,
+               transfer_update)
 from .state import LpvGridState, cascade_grids
 
 # Outputs kept per pass (gl/pass_cache.py): the geometry's passes for two settings (the live viewport's draft and
@@ -278,11 +279,12 @@ def skipped_work(stats: list, s) -> list:
 
 def _build(ctx, programs, gv, grid, budget, s, prior=None) -> transfer.Transfer:
     """Clusters and T of one cascade: updated from `prior` (the same grid before a geometry edit) where that
-    re-evaluates under half of T, else made anew with the budget re-checked against the real surface-voxel count."""
-    if prior is not None and prior.grid == grid:
-        sources, matrix, share = transfer.update_transfer(ctx, programs, gv, grid, s.occlusion, prior)
-        if share < 0.5:
-            return transfer.sort_by_cluster(sources, matrix, gv, grid, share)
+    re-evaluates under half of T (lpv/transfer_update.py), else made anew with the budget re-checked against the
+    real surface-voxel count."""
+    updated = transfer_update.update_transfer(ctx, programs, gv, grid, s.occlusion, prior) \
+        if prior is not None and prior.grid == grid else None
+    if updated is not None:
+        return updated
     fits = int(s.transfer_mb * 2 ** 20 / (8 * max(gv.surface_count, 1)))
     sources = clusters.make_clusters(gv.cells, gv.surface_normal, gv.surface_area, gv.fine,
                                      max(transfer.MIN_CLUSTERS, min(budget, fits)), positions=gv.positions,

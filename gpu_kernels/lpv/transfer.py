@@ -16,8 +16,8 @@ only:
 
 where reflect(E) sums albedo × area × E over each cluster's voxel sides, and M_ρ = reflect ∘ T, the cluster-to-
 cluster transfer with the receivers' albedo (re-built on a material edit, which re-voxelises only the albedo:
-occupancy and T are kept). A geometry edit updates T (update_transfer) instead of rebuilding it. This is the
-precomputed-radiosity factorisation of Enlighten-style systems (Martin and Einarsson, "A real-time radiosity
+occupancy and T are kept). A geometry edit updates T (lpv/transfer_update.py) instead of rebuilding it. This is
+the precomputed-radiosity factorisation of Enlighten-style systems (Martin and Einarsson, "A real-time radiosity
 architecture for video games", SIGGRAPH 2010 course), evaluated live. Every bounce is computed (no tail
 extrapolation); the series stops once a bounce adds less than `epsilon` of the largest pass's flux.
 
@@ -40,37 +40,31 @@ MIN_CLUSTERS = 64  # fewer sources than this blur a room's bounce into a few blo
 ROWS_BYTES = 8 << 20  # GPU buffer T is read back through, a dispatch at a time
 
 
-def build_transfer(ctx, programs, gv, grid: Grid, clusters: Clusters, occlusion: bool, update=None) -> np.ndarray:
+def kernel_program(ctx, programs, gv, grid: Grid, clusters: Clusters, occlusion: bool, defines=None) -> tuple:
+    """lpv/gather.glsl's MODE_TRANSFER program with the geometry volume, its receivers and `clusters`' records and
+    polygons bound: (program, the buffers made for it, to release)."""
+    prog = programs.compute("lpv/gather.glsl", {"MODE_TRANSFER": 1, **(defines or {})})
+    bind_visibility(prog, gv)
+    gv.receivers.bind_to_storage_buffer(10)
+    set_uniform(prog, "u_occlusion", bool(occlusion))
+    set_uniform(prog, "u_surface_count", int(gv.surface_count))
+    bind_grid(prog, grid)
+    sources = ctx.buffer(clusters.records.tobytes())
+    sources.bind_to_storage_buffer(6)
+    polygons = ctx.buffer(np.ascontiguousarray(clusters.polygon, np.float32).tobytes())
+    polygons.bind_to_storage_buffer(9)
+    return prog, [sources, polygons]
+
+
+def build_transfer(ctx, programs, gv, grid: Grid, clusters: Clusters, occlusion: bool) -> np.ndarray:
     """T: (2, C, R) float32 — what cluster c of unit flux gives receiver r's front (0) and back (1) side, the kernel
     of lpv/gather.glsl evaluated on the GPU (MODE_TRANSFER), in dispatches of at most vpls_per_dispatch sources
-    and ROWS_BYTES. With `update` = (fresh receivers (R,) bool, fresh clusters (C,) bool, box (2, 3)), only pairs with
-    a fresh end or a ray through the box are evaluated; the rest come back NaN (update_transfer fills them)."""
+    and ROWS_BYTES."""
     r, c = int(gv.surface_count), clusters.count
     out = np.zeros((2, c, r), np.float32)
     if r == 0 or c == 0:
         return out
-    prog = programs.compute("lpv/gather.glsl", {"MODE_TRANSFER": 1})
-    bind_visibility(prog, gv)
-    gv.receivers.bind_to_storage_buffer(10)
-    set_uniform(prog, "u_occlusion", bool(occlusion))
-    set_uniform(prog, "u_fine_origin", tuple(float(v) for v in gv.fine.origin))
-    set_uniform(prog, "u_surface_count", r)
-    bind_grid(prog, grid)
-    records, receivers = clusters.records.copy(), None
-    set_uniform(prog, "u_update", update is not None)
-    if update is not None:
-        fresh_receivers, fresh_clusters, box = update
-        records["flux"][:, 3] = fresh_clusters
-        cells = np.zeros((r, 4), np.int32)
-        cells[:, :3], cells[:, 3] = gv.cells, fresh_receivers
-        receivers = ctx.buffer(cells.tobytes())
-        set_uniform(prog, "u_box_lo", tuple(float(v) for v in box[0]))
-        set_uniform(prog, "u_box_hi", tuple(float(v) for v in box[1]))
-    sources = ctx.buffer(records.tobytes())
-    sources.bind_to_storage_buffer(6)
-    polygons = ctx.buffer(np.ascontiguousarray(clusters.polygon, np.float32).tobytes())
-    polygons.bind_to_storage_buffer(9)
-    (receivers or gv.surfaces).bind_to_storage_buffer(7)
+    prog, buffers = kernel_program(ctx, programs, gv, grid, clusters, occlusion)
     chunk = max(1, min(vpls_per_dispatch(grid), ROWS_BYTES // (8 * r)))
     rows = ctx.buffer(reserve=min(chunk, c) * r * 8)
     rows.bind_to_storage_buffer(8)
@@ -83,77 +77,9 @@ def build_transfer(ctx, programs, gv, grid: Grid, clusters: Clusters, occlusion:
         block = np.frombuffer(rows.read(size=count * r * 8), np.float32).reshape(count, r, 2)
         out[0, first:first + count] = block[..., 0]
         out[1, first:first + count] = block[..., 1]
-    for buffer in (rows, sources, polygons, receivers):
-        if buffer is not None:
-            buffer.release()
+    for buffer in buffers + [rows]:
+        buffer.release()
     return out
-
-
-def _match(old: np.ndarray, new: np.ndarray) -> np.ndarray:
-    """For each row of `new` (structured or 2-D), the index of an identical row of `old`, or −1."""
-    old_keys = {row.tobytes(): i for i, row in enumerate(old)}
-    return np.array([old_keys.get(row.tobytes(), -1) for row in new], np.int64)
-
-
-def _receivers(cells, axis, normals, areas) -> np.ndarray:
-    """(R, 8) rows a receiver is compared by: its fine voxel, axis, normal and area."""
-    return np.concatenate([cells.astype(np.float64), axis[:, None], normals, areas[:, None]], axis=1)
-
-
-def _match_receivers(old: np.ndarray, new: np.ndarray) -> np.ndarray:
-    """_match for _receivers rows, vectorised: a receiver is one (voxel, axis), so rows are paired by that key
-    (sorted search) and then kept only where the whole row (normal, area) is equal."""
-    def key(rows):
-        c = rows[:, :4].astype(np.int64)
-        return ((c[:, 2] * (1 << 20) + c[:, 1]) * (1 << 20) + c[:, 0]) * 4 + c[:, 3]
-    old_key, new_key = key(old), key(new)
-    order = np.argsort(old_key, kind="stable")
-    at = np.minimum(np.searchsorted(old_key[order], new_key), max(len(old) - 1, 0))
-    if len(old) == 0:
-        return np.full(len(new), -1, np.int64)
-    index = order[at]
-    same = (old_key[index] == new_key) & (old[index] == new).all(axis=1)
-    return np.where(same, index, -1)
-
-
-def changed_box(moved: np.ndarray, grid: Grid):
-    """The box (2, 3) of the LPV cells holding the fine voxels `moved` (voxels that appeared, vanished, or got
-    another normal or area): a cell's visibility planes come from its eight voxels (lpv/crossings.py; LPV cell c
-    holds fine voxels 2c + 1 and 2c + 2 along each axis). None when none did."""
-    if len(moved) == 0:
-        return None
-    cells = np.floor((np.asarray(moved) - 1) / 2)
-    origin = np.asarray(grid.origin)
-    return np.stack([origin + cells.min(axis=0) * grid.cell, origin + (cells.max(axis=0) + 1) * grid.cell])
-
-
-def update_transfer(ctx, programs, gv, grid: Grid, occlusion: bool, prior) -> tuple:
-    """T after a geometry edit, from `prior` (the Transfer before it): the clusters re-made with the same blocks,
-    and only the pairs the edit can change re-evaluated — a new receiver or source, or a ray through the changed
-    box. Returns (clusters, matrix, the share of pairs re-evaluated)."""
-    from .clusters import make_clusters
-
-    new = make_clusters(gv.cells, gv.surface_normal, gv.surface_area, gv.fine, 0, block=prior.clusters.block,
-                        positions=gv.positions, bounds=gv.bounds)
-    before = _receivers(prior.cells, prior.axis, prior.normals, prior.areas)
-    after = _receivers(gv.cells, gv.axis, gv.surface_normal, gv.surface_area)
-    old_r = _match_receivers(before, after)
-    old_c = _match(prior.clusters.records, new.records)
-    gone = _match_receivers(after, before) < 0
-    box = changed_box(np.concatenate([before[gone, :3], after[old_r < 0, :3]]), grid)
-    if box is None:
-        box = np.zeros((2, 3))
-    matrix = build_transfer(ctx, programs, gv, grid, new, occlusion, (old_r < 0, old_c < 0, box))
-    kept = 0
-    for side in range(2):  # the kept pairs' old values: prior's columns are sorted by cluster, undo that
-        keep = np.isnan(matrix[side])
-        kept += int(np.count_nonzero(keep))
-        position = np.empty(len(prior.order[side]), np.int64)
-        position[prior.order[side]] = np.arange(len(position))
-        # np.take, not fancy indexing: several times faster on a matrix this size (numpy gathers columns row by row)
-        rows = np.take(prior.matrix[side], np.maximum(old_c, 0), axis=0)
-        np.copyto(matrix[side], np.take(rows, position[np.maximum(old_r, 0)], axis=1), where=keep)
-    return new, matrix, 1.0 - kept / max(matrix.size, 1)
 
 
 @dataclass
@@ -178,21 +104,35 @@ class Transfer:
         return self.matrix.nbytes
 
 
-def sort_by_cluster(clusters: Clusters, matrix: np.ndarray, gv=None, grid: Grid | None = None,
-                    updated: float = 1.0) -> Transfer:
-    """`matrix` (2, C, R) in receiver order → a Transfer with each side's columns grouped by cluster (and the
-    receivers of `gv` recorded)."""
-    order, starts, out = [], [], np.empty_like(matrix)
+def cluster_order(clusters: Clusters) -> tuple[list, list]:
+    """Per side: the receivers in the order of their side's clusters (stable: by receiver within one), and each
+    cluster's first column in that order (C + 1; the receivers whose side has no cluster last)."""
+    order, starts = [], []
     for side in range(2):
         members = clusters.side_cluster[:, side]
         key = np.where(members >= 0, members, clusters.count)
         perm = np.argsort(key, kind="stable")
-        np.take(matrix[side], perm, axis=1, out=out[side])  # 5× faster than matrix[side][:, perm] here
         order.append(perm)
         starts.append(np.searchsorted(key[perm], np.arange(clusters.count + 1)))
+    return order, starts
+
+
+def sort_by_cluster(clusters: Clusters, matrix: np.ndarray, gv=None, grid: Grid | None = None) -> Transfer:
+    """`matrix` (2, C, R) in receiver order → a Transfer with each side's columns grouped by cluster (and the
+    receivers of `gv` recorded)."""
+    order, starts = cluster_order(clusters)
+    out = np.empty_like(matrix)
+    for side in range(2):
+        np.take(matrix[side], order[side], axis=1, out=out[side])  # 5× faster than matrix[side][:, perm] here
+    return sorted_transfer(clusters, out, order, starts, gv, grid)
+
+
+def sorted_transfer(clusters: Clusters, matrix: np.ndarray, order: list, starts: list, gv=None,
+                    grid: Grid | None = None, updated: float = 1.0) -> Transfer:
+    """A Transfer of `matrix` whose columns are already in cluster_order's `order`."""
     if gv is None:
-        return Transfer(clusters, out, order, starts, updated=updated)
-    return Transfer(clusters, out, order, starts, grid, gv.cells.copy(), gv.axis.copy(), gv.surface_normal.copy(),
+        return Transfer(clusters, matrix, order, starts, updated=updated)
+    return Transfer(clusters, matrix, order, starts, grid, gv.cells.copy(), gv.axis.copy(), gv.surface_normal.copy(),
                     gv.surface_area.copy(), updated)
 
 

@@ -170,3 +170,20 @@ def test_the_transport_is_capped_only_where_its_reflection_is_impossible():
         np.testing.assert_allclose(gain, np.where(want > 1, 1 / want, 1.0), rtol=1e-5)
         np.testing.assert_allclose(bounded, m * gain[None, None, :], rtol=1e-6)
         assert max(tr.spectral_radius(bounded[ch]) for ch in range(3)) <= 0.8 * (1 + 1e-6)
+
+
+@pytest.mark.parametrize("runs", [True, False])
+def test_take_columns_is_a_column_gather(runs):
+    """transfer_update.take_columns copies runs of consecutive columns as slices (or gathers, where runs are short):
+    the same as np.take either way."""
+    from bounce_gi.gpu_kernels.lpv.transfer_update import take_columns
+    rng = np.random.default_rng(3)
+    src = rng.random((7, 500)).astype(np.float32)
+    if runs:  # blocks of consecutive columns, shuffled, one column repeated (a fresh receiver's placeholder)
+        blocks = [np.arange(a, a + n) for a, n in ((300, 40), (0, 120), (120, 5), (200, 90), (0, 1), (450, 50))]
+        columns = np.concatenate([blocks[i] for i in rng.permutation(len(blocks))])
+    else:
+        columns = rng.integers(0, 500, 300)
+    out = np.empty((7, len(columns)), np.float32)
+    take_columns(src, columns, out)
+    assert np.array_equal(out, np.take(src, columns, axis=1))

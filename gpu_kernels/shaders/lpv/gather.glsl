@@ -47,23 +47,17 @@ layout(std430, binding = 8) writeonly buffer Transfer { vec2 transfer[]; };  // 
 // The receivers (lpv/receivers.py): a voxel's surfaces of one dominant axis each, surfaces[i] its voxel and
 // receivers[2i] its mean normal (xyz) and area (w), receivers[2i + 1] its surfaces' centroid.
 layout(std430, binding = 10) readonly buffer Receivers { vec4 receivers[]; };
-// An update after an edit (lpv/transfer.update_transfer): only pairs whose receiver or source is new (w / flux.w
-// set) or whose ray passes through the changed box are evaluated; the others are marked NaN and keep their value.
-uniform bool u_update;
-uniform vec3 u_box_lo;
-uniform vec3 u_box_hi;
 // Per source: the octagon its surfaces span in its plane (lpv/clusters.Clusters.polygon), eight corners in order;
 // the first's w is 1 where the cluster is planar, the second's its area.
 layout(std430, binding = 9) readonly buffer SourcePolygons { vec4 source_polygons[]; };
-
-bool crosses_box(vec3 a, vec3 b) {  // the segment a → b meets the box (slab test)
-    vec3 d = b - a;
-    vec3 inv = vec3(d.x != 0.0 ? 1.0 / d.x : 1e30, d.y != 0.0 ? 1.0 / d.y : 1e30, d.z != 0.0 ? 1.0 / d.z : 1e30);
-    vec3 t0 = (u_box_lo - a) * inv, t1 = (u_box_hi - a) * inv;
-    float enter = max(max(min(t0.x, t1.x), min(t0.y, t1.y)), min(t0.z, t1.z));
-    float leave = min(min(max(t0.x, t1.x), max(t0.y, t1.y)), max(t0.z, t1.z));
-    return enter <= leave && leave >= 0.0 && enter <= 1.0;
-}
+#if defined(PAIRS)
+// An update after an edit (lpv/transfer.update_transfer): only the listed (source, receiver) pairs, one per
+// invocation — on llvmpipe a branch runs for every lane whenever any lane takes it, so pairs skipped inside the loop
+// over sources cost what evaluated ones do.
+layout(std430, binding = 11) readonly buffer Pairs { ivec2 pairs[]; };
+uniform int u_pair_first;
+uniform int u_pair_count;
+#endif
 #else
 layout(rgba32f, binding = 0) uniform image3D u_front;  // this bounce: rgb irradiance (W/m²), a = 1 if surface
 layout(rgba32f, binding = 1) uniform image3D u_back;
@@ -267,36 +261,41 @@ vec2 vpl_kernel(int j, Vpl v, vec3 p, vec3 nv, float h) {
     return k;
 }
 
+#if defined(MODE_TRANSFER)
+// What source j of unit flux gives receiver i (lpv/receivers.py: receivers[2i] its mean normal and area,
+// receivers[2i + 1] its surfaces' centroid), per side.
+vec2 receiver_kernel(int j, int i) {
+    vec4 oriented = receivers[2 * i];
+    vec3 nv = oriented.xyz;
+    if (!(oriented.w > 0.0 && dot(nv, nv) > 0.0)) return vec2(0.0);
+    return vpl_kernel(j, vpls[j], receivers[2 * i + 1].xyz, normalize(nv), 0.5 * u_grid_cell);
+}
+
+#if defined(PAIRS)
+void main() {  // transfer[k] = pair k's (front, back)
+    int k = int(gl_GlobalInvocationID.x);
+    if (k >= u_pair_count) return;
+    ivec2 pair = pairs[u_pair_first + k];
+    transfer[k] = receiver_kernel(pair.x, pair.y);
+}
+#else
+void main() {  // one row per source of this dispatch: transfer[(j − first) · surfaces + receiver] = (front, back)
+    int i = int(gl_GlobalInvocationID.x);
+    if (i >= u_surface_count) return;
+    for (int j = u_vpl_first; j < u_vpl_first + u_vpl_count; ++j)
+        transfer[(j - u_vpl_first) * u_surface_count + i] = receiver_kernel(j, i);
+}
+#endif
+#else
 void main() {
     if (int(gl_GlobalInvocationID.x) >= u_surface_count) return;
     ivec3 f = surfaces[gl_GlobalInvocationID.x].xyz;
-#if defined(MODE_TRANSFER)
-    int i = int(gl_GlobalInvocationID.x);
-    vec4 oriented = receivers[2 * i];  // one of the voxel's receivers (lpv/receivers.py)
-    vec3 nv = oriented.xyz;
-    bool receives = oriented.w > 0.0 && dot(nv, nv) > 0.0;
-    vec3 p = receivers[2 * i + 1].xyz;
-#else
     vec4 area = texelFetch(u_voxel_area, f, 0);
     vec3 nv = texelFetch(u_voxel_normal, f, 0).xyz;
-    bool receives = area.a > 0.0 && dot(nv, nv) > 0.0;
-#endif
-    nv = receives ? normalize(nv) : vec3(0.0, 0.0, 1.0);
+    if (!(area.a > 0.0 && dot(nv, nv) > 0.0)) return;
+    nv = normalize(nv);
     float h = 0.5 * u_grid_cell;
-#if !defined(MODE_TRANSFER)
     vec3 p = u_fine_origin + (vec3(f) + 0.5) * h;
-#endif
-#if defined(MODE_TRANSFER)
-    // One row per source of this dispatch: transfer[(j − first) · surfaces + receiver] = (front, back).
-    bool fresh_receiver = !u_update || surfaces[gl_GlobalInvocationID.x].w != 0;
-    for (int j = u_vpl_first; j < u_vpl_first + u_vpl_count; ++j) {
-        bool fresh = fresh_receiver || vpls[j].flux.w != 0.0 || crosses_box(vpls[j].position.xyz, p);
-        transfer[(j - u_vpl_first) * u_surface_count + int(gl_GlobalInvocationID.x)] =
-            !fresh ? vec2(uintBitsToFloat(0x7fc00000u)) :
-            receives ? vpl_kernel(j, vpls[j], p, nv, h) : vec2(0.0);
-    }
-#else
-    if (!receives) return;
     vec3 front = vec3(0.0), back = vec3(0.0);
     for (int j = u_vpl_first; j < u_vpl_first + u_vpl_count; ++j) {
         vec2 k = vpl_kernel(j, vpls[j], p, nv, h);
@@ -307,5 +306,5 @@ void main() {
     imageStore(u_back, f, vec4(imageLoad(u_back, f).rgb + back, 1.0));
     imageStore(u_front_total, f, vec4(imageLoad(u_front_total, f).rgb + front, 1.0));
     imageStore(u_back_total, f, vec4(imageLoad(u_back_total, f).rgb + back, 1.0));
-#endif
 }
+#endif

@@ -1,0 +1,39 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Which (source, receiver) pairs of the cached transport a geometry edit can change through their visibility
+// (lpv/transfer.box_pairs): those whose segment passes through the box of the cells the edit changed. One bit per
+// pair, 32 receivers to a word: mask[(j − first) · words + w] bit b = receiver 32w + b, source j.
+layout(local_size_x = 64) in;
+#include "common/structs.glsl"
+layout(std430, binding = 6) readonly buffer VplList { Vpl vpls[]; };
+// lpv/receivers.py: receivers[2i + 1] is receiver i's surfaces' centroid (where lpv/gather.glsl's kernel starts)
+layout(std430, binding = 10) readonly buffer Receivers { vec4 receivers[]; };
+layout(std430, binding = 8) writeonly buffer Mask { uint mask[]; };
+uniform int u_surface_count;
+uniform int u_words;
+uniform int u_vpl_first;
+uniform int u_vpl_count;
+uniform vec3 u_box_lo;
+uniform vec3 u_box_hi;
+
+bool crosses_box(vec3 a, vec3 b) {  // the segment a → b meets the box (slab test)
+    vec3 d = b - a;
+    vec3 inv = vec3(d.x != 0.0 ? 1.0 / d.x : 1e30, d.y != 0.0 ? 1.0 / d.y : 1e30, d.z != 0.0 ? 1.0 / d.z : 1e30);
+    vec3 t0 = (u_box_lo - a) * inv, t1 = (u_box_hi - a) * inv;
+    float enter = max(max(min(t0.x, t1.x), min(t0.y, t1.y)), min(t0.z, t1.z));
+    float leave = min(min(max(t0.x, t1.x), max(t0.y, t1.y)), max(t0.z, t1.z));
+    return enter <= leave && leave >= 0.0 && enter <= 1.0;
+}
+
+void main() {
+    int w = int(gl_GlobalInvocationID.x);
+    if (w >= u_words) return;
+    for (int j = u_vpl_first; j < u_vpl_first + u_vpl_count; ++j) {
+        vec3 a = vpls[j].position.xyz;
+        uint bits = 0u;
+        for (int b = 0; b < 32; ++b) {
+            int i = 32 * w + b;
+            if (i < u_surface_count && crosses_box(a, receivers[2 * i + 1].xyz)) bits |= 1u << uint(b);
+        }
+        mask[(j - u_vpl_first) * u_words + w] = bits;
+    }
+}
