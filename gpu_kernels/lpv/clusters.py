@@ -302,6 +302,23 @@ def own_side(clusters: Clusters, cells: np.ndarray, normals: np.ndarray, pos: np
     return out
 
 
+def _block_cluster(clusters: Clusters, pos: np.ndarray, normal: np.ndarray, first: np.ndarray, last: np.ndarray,
+                   near: float) -> np.ndarray:
+    """Per record: the cluster among clusters.key[first:last] (its block and side) within `near` of it whose plane
+    lies nearest, or −1 where none is that near."""
+    target = np.full(len(pos), -1)
+    offset = np.einsum("ij,ij->i", normal, pos)
+    best = np.full(len(pos), np.inf)
+    for j in range(int((last - first).max(initial=0))):  # candidates of one key: usually one, a few planes at most
+        c = np.minimum(first + j, clusters.count - 1)
+        lo, hi = clusters.offsets[c, 0], clusters.offsets[c, 1]
+        plane = np.maximum(lo - offset, 0) + np.maximum(offset - hi, 0)
+        d = np.where((first + j < last) & (box_distance(pos, clusters.box[c]) <= near), plane, np.inf)
+        better = d < best
+        target[better], best[better] = c[better], d[better]
+    return target
+
+
 def bin_flux(clusters: Clusters, records: np.ndarray, cells: np.ndarray | None = None,
              normals: np.ndarray | None = None, groups: int | None = None,
              axis: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray | float]:
@@ -329,17 +346,9 @@ def bin_flux(clusters: Clusters, records: np.ndarray, cells: np.ndarray | None =
     faces = faces_something(pos, normal, clusters.lo, clusters.hi, near)
     own = np.full(len(records), -1) if cells is None else own_side(clusters, cells, normals, pos, normal, axis)
     own[~faces] = -2  # nothing lies before it (a roof's top): its light leaves, whichever voxel side it shares
-    target = np.full(len(records), -1)
-    offset = np.einsum("ij,ij->i", normal, pos)
-    best = np.where(own == -1, np.inf, -np.inf)  # records with a voxel of their own take no other
-    for j in range(int((last - first).max(initial=0))):  # candidates of one key: usually one, a few planes at most
-        c = np.minimum(first + j, clusters.count - 1)
-        lo, hi = clusters.offsets[c, 0], clusters.offsets[c, 1]
-        plane = np.maximum(lo - offset, 0) + np.maximum(offset - hi, 0)
-        d = np.where((first + j < last) & (box_distance(pos, clusters.box[c]) <= near), plane, np.inf)
-        better = d < best
-        target[better], best[better] = c[better], d[better]
-    target = np.where(own >= 0, own, target)
+    target = np.where(own >= 0, own, -1)
+    alone = np.nonzero(own == -1)[0]  # records with a voxel of their own take no other: the rest search their block
+    target[alone] = _block_cluster(clusters, pos[alone], normal[alone], first[alone], last[alone], near)
     lost = np.nonzero((target < 0) & (own == -1))[0]
     for chunk in np.array_split(lost, max(1, len(lost) // 256)) if len(lost) and clusters.count else ():
         facing = normal[chunk] @ clusters.records["normal"][:, :3].T > 0.5  # (n, C)

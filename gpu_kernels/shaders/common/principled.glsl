@@ -77,10 +77,6 @@ vec3 glossy_fresnel_at(GlossyFresnel f, float hv) {
     return k;
 }
 
-vec3 principled_glossy_fresnel(sampler2D lut, int material, float mu, vec3 base, float hv) {
-    return glossy_fresnel_at(glossy_fresnel_rows(lut, material, mu, base), hv);
-}
-
 // E(μ): the GGX lobe's albedo with Fresnel 1 at the material's roughness (Cycles' energy_scale is 1/E).
 float principled_ggx_albedo(sampler2D lut, int material, float mu) {
     return principled_row(lut, 5 * material, mu).a;

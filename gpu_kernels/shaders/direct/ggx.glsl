@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Unshadowed glossy reflection of one light toward the viewer: Cycles' GGX (α = roughness², the GGX distribution
 // and Smith's height-correlated masking-shadowing, Walter et al. 2007; Heitz 2014) with each closure's Fresnel and
-// weight (common/principled.glsl: principled_glossy_fresnel), for Glossy Direct (direct/light.glsl). Polygon lights (area lights, emissive triangles) are integrated by quadrature
-// over sub-triangles of their fan; the linearly transformed cosines of Heitz et al. 2016 would be exact for rough
-// and smooth lobes alike, and are not done yet, so lobes much narrower than the polygon's sub-triangles alias.
+// weight (common/principled.glsl: glossy_fresnel_at), for Glossy Direct (direct/light.glsl). Polygon lights (area
+// lights, emissive triangles) are integrated by quadrature over sub-triangles of their fan; the linearly transformed
+// cosines of Heitz et al. 2016 would be exact for rough and smooth lobes alike, and are not done yet, so lobes much
+// narrower than the polygon's sub-triangles alias.
 #pragma once
 #include "common/lights.glsl"
 #include "common/light_eval.glsl"
@@ -19,8 +20,9 @@ struct GlossyLobe {
     vec3 base;
 };
 
-// The lobe's f(v, l)·cosθ_l: D·G2/(4 μ_v) times the closures' Fresnel-weighted albedo at h·v.
-vec3 lobe_cos(sampler2D lut, GlossyLobe g, vec3 n, vec3 v, vec3 l) {
+// The lobe's f(v, l)·cosθ_l: D·G2/(4 μ_v) times the closures' Fresnel-weighted albedo at h·v (`f`: the material's
+// rows at the lobe's μ, glossy_fresnel_rows — read once per pixel, not once per light sample).
+vec3 lobe_cos(GlossyFresnel f, GlossyLobe g, vec3 n, vec3 v, vec3 l) {
     float mu_l = dot(n, l);
     if (g.mu <= 0.0 || mu_l <= 0.0) return vec3(0.0);
     vec3 h = normalize(v + l);
@@ -29,7 +31,7 @@ vec3 lobe_cos(sampler2D lut, GlossyLobe g, vec3 n, vec3 v, vec3 l) {
     float t = 1.0 - c2 + a2 * c2;
     float d = a2 / (PI * t * t);
     float g2 = 1.0 / (1.0 + ggx_lambda(a2, g.mu) + ggx_lambda(a2, mu_l));
-    return principled_glossy_fresnel(lut, g.material, g.mu, g.base, dot(h, v)) * (d * g2 / (4.0 * g.mu));
+    return glossy_fresnel_at(f, dot(h, v)) * (d * g2 / (4.0 * g.mu));
 }
 
 // The weight of sky direction d in the glossy lobe's share of the sky (direct/light.glsl): the lobe's own
@@ -48,7 +50,7 @@ float sky_lobe_weight(GlossyLobe g, GlossyFresnel fresnel, float a2, vec3 n, vec
 // Σ over quadrature points of the polygon: radiance × f·cosθ_l × cosθ_emitter·dA / d². The polygon is read as
 // triangles (common/light_eval.glsl: polygon_triangle), a fan or an emitter cluster's list, each triangle with its
 // own radiance scale and, for two-sided emitters, its own normal.
-vec3 polygon_glossy(sampler2D lut, GlossyLobe g, GpuLight L, vec3 p, vec3 n, vec3 v) {
+vec3 polygon_glossy(GlossyFresnel f, GlossyLobe g, GpuLight L, vec3 p, vec3 n, vec3 v) {
     bool two_sided = L.polygon.z > 0.5;
     int count = polygon_triangle_count(L);
     int k = max(1, int(sqrt(float(GLOSSY_POLYGON_SAMPLES) / float(max(count, 1)))));
@@ -77,7 +79,7 @@ vec3 polygon_glossy(sampler2D lut, GlossyLobe g, GpuLight L, vec3 p, vec3 n, vec
                     vec3 l = w * inversesqrt(d2);
                     float cos_e = -dot(emit_n, l);
                     cos_e = both_faces ? abs(cos_e) : max(cos_e, 0.0);
-                    if (cos_e > 0.0) tri += lobe_cos(lut, g, n, v, l) * (cos_e * sub_area / d2);
+                    if (cos_e > 0.0) tri += lobe_cos(f, g, n, v, l) * (cos_e * sub_area / d2);
                 }
             }
         }
@@ -87,20 +89,20 @@ vec3 polygon_glossy(sampler2D lut, GlossyLobe g, GpuLight L, vec3 p, vec3 n, vec
 }
 
 // The light's glossy reflection toward v: Σ weight × darkening × F × f·cosθ (Glossy Color × Glossy Direct, before
-// Cycles' 1/E energy scale, which direct/light.glsl applies).
-vec3 light_glossy(sampler2D lut, GlossyLobe g, GpuLight L, vec3 p, vec3 n, vec3 v) {
+// Cycles' 1/E energy scale, which direct/light.glsl applies); `f`: glossy_fresnel_rows of the lobe.
+vec3 light_glossy(GlossyFresnel f, GlossyLobe g, GpuLight L, vec3 p, vec3 n, vec3 v) {
     if (g.alpha * g.alpha <= 5e-7) return vec3(0.0);  // Cycles evaluates no singular lobe against a light
     int type = int(L.color_type.w);
     if (type == LIGHT_SKY) return vec3(0.0);  // the world's reflection: direct/light.glsl, with its visibility
     vec3 color = L.color_type.rgb;
-    if (type == LIGHT_SUN) return color * lobe_cos(lut, g, n, v, -L.direction.xyz);
+    if (type == LIGHT_SUN) return color * lobe_cos(f, g, n, v, -L.direction.xyz);
     if (type == LIGHT_POINT || type == LIGHT_SPOT) {
         vec3 d = L.position.xyz - p;
         float d2 = max(dot(d, d), 1e-8);
         vec3 wi = d * inversesqrt(d2);
         float att = type == LIGHT_SPOT ? spot_attenuation(L, -wi) : 1.0;
-        return color * (att / (d2 + L.position.w)) * lobe_cos(lut, g, n, v, wi);
+        return color * (att / (d2 + L.position.w)) * lobe_cos(f, g, n, v, wi);
     }
     if (!(L.polygon.z > 0.5) && dot(p - L.position.xyz, L.direction.xyz) <= 0.0) return vec3(0.0);
-    return polygon_glossy(lut, g, L, p, n, v);
+    return polygon_glossy(f, g, L, p, n, v);
 }

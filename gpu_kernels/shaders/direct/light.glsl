@@ -101,6 +101,7 @@ void main() {
     return;
 #endif
     vec3 irradiance = vec3(0.0), reflected = vec3(0.0), world = vec3(0.0);
+    GlossyFresnel fresnel = glossy_fresnel_rows(u_material_lut, lobe.material, lobe.mu, lobe.base);
     for (int j = 0; j < u_group_count; ++j) {
         int i = group_lights[j];
         if (int(lights[i].color_type.w) == LIGHT_SKY) {
@@ -114,7 +115,7 @@ void main() {
             continue;
         }
         vec3 e = light_unshadowed(lights[i], pos.xyz, n);
-        vec3 g = has_glossy ? light_glossy(u_material_lut, lobe, lights[i], pos.xyz, n, v) : vec3(0.0);
+        vec3 g = has_glossy ? light_glossy(fresnel, lobe, lights[i], pos.xyz, n, v) : vec3(0.0);
         if (max(max(e.r, e.g), max(max(e.b, g.r), max(g.g, g.b))) <= 0.0) continue;
         float vis = light_visibility(lights[i], pos.xyz, n, geo_n);
         irradiance += e * vis;
