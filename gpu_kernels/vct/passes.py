@@ -2,18 +2,21 @@
 """The VCT's passes in the pipeline's pass cache (pipeline.METHOD_PASSES["vct"]):
 
     vct_voxelize    ← geometry, materials, grid
-    vct_inject      ← voxels, shadow maps (lights)
+    vct_inject      ← voxels, shadow maps, the lights per unit of the largest colour (vct/colours.py)
     vct_mipmap      ← injection, anisotropy
     vct_bounce      ← mipmaps, cone settings, bounces
     vct_specular    ← gbuffer, bounced volumes, specular settings
     vct_trace       ← gbuffer, bounced volumes, trace settings, accumulation frame
     vct_upsample    ← vct_trace (indirect_scale > 1)
     vct_accumulate  ← the upsampled trace (temporal_frames > 1)
+    vct_scale       ← the results, the largest light colour (scaled back to the lights' own colours)
 """
 from __future__ import annotations
 
+import numpy as np
+
 from ..common.method import MethodOutput
-from . import bounce, inject, mipmap, specular, temporal, trace, upsample
+from . import bounce, colours, inject, mipmap, specular, temporal, trace, upsample
 from .volumes import mip_levels, vct_grid, voxelize_scene
 
 # Outputs kept per pass (gl/pass_cache.py): the voxels of two grids (the live viewport's draft and final stages).
@@ -29,9 +32,14 @@ def run(frame) -> MethodOutput:
     k_vox = (frame.keys["geometry"], frame.keys["materials"], grid.key())
     vox = cache.run("vct_voxelize", k_vox,
                     lambda: voxelize_scene(ctx, programs, scene, frame.geometry, frame.textures, grid))
-    k_inject = (k_vox, frame.keys["shadow"], levels)
-    faces = cache.run("vct_inject", k_inject, lambda: inject.inject(ctx, programs, scene, frame.geometry,
-                                                                    frame.textures, vox, frame.shadows, levels))
+    # The lights per unit of the largest colour (vct/colours.py): an edit scaling every light alike keeps all that
+    # follows, and only the results are scaled back.
+    scale = colours.colour_scale(frame.shadows)
+    records = colours.unit_records(frame.shadows, scale)
+    k_inject = (k_vox, colours.unit_key(frame.shadows, records), levels)
+    faces = cache.run("vct_inject", k_inject, lambda: colours.with_records(
+        ctx, frame.shadows, records, lambda shadows: inject.inject(ctx, programs, scene, frame.geometry,
+                                                                   frame.textures, vox, shadows, levels)))
     k_mip = (k_inject, s.anisotropic)
     volumes = cache.run("vct_mipmap", k_mip, lambda: mipmap.build_volumes(ctx, programs, faces, s.anisotropic))
     k_bounce = (k_mip, s.key("bounce"))
@@ -44,7 +52,11 @@ def run(frame) -> MethodOutput:
                                                                           s.key("trace")))
     info = {**trace.render_info(faces, bounced, s), "specular_pixels": glossy["traced"], **extra,
             "skipped_work": bounce.skipped_work(bounced.bounce_stats or [], s) + specular.skipped_work(glossy, s)}
-    return MethodOutput(indirect, glossy["glossy"], (k_trace, k_spec), info, has_ao=True)
+    key, out = (k_trace, k_spec), (indirect, glossy["glossy"])
+    if np.any(scale != 1.0):
+        key = (k_trace, k_spec, scale.tobytes())
+        out = cache.run("vct_scale", key, lambda: colours.scale_output(ctx, list(out), scale))
+    return MethodOutput(*out, key, colours.scale_info(info, scale), has_ao=True)
 
 
 def _per_pixel(frame, faces, bounced, base):

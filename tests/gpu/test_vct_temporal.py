@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """Temporal accumulation of the VCT diffuse gather (gpu_kernels/vct/temporal.py): repeated renders of an unchanged scene each
 add one frame with the cone set turned about the normal; the history is the mean of the frames; any change of the
-trace's inputs restarts it (no ghost of the old scene)."""
+trace's inputs restarts it (no ghost of the old scene) — but an edit that scales every light alike, which the trace
+reads per unit of the lights' colour (vct/colours.py), keeps it."""
 import dataclasses
 
 import numpy as np
@@ -77,14 +78,23 @@ def test_any_change_restarts_the_history_without_a_ghost(engine):
     settings = _settings(temporal_frames=N)
     for _ in range(N):
         engine.render(scene, settings)
-    # A change of the scene (the sun twice as strong), of the camera, and of the trace settings: each first frame
+    # The sun twice as strong scales the whole transport (vct/colours.py): the complete history is kept, scaled.
+    complete = engine.render(scene, settings)
+    sun = scene.lights[0]
+    brighter = dataclasses.replace(scene, lights=[dataclasses.replace(sun, power=2.0 * sun.power)])
+    r = engine.render(brighter, settings)
+    assert r.info["temporal"]["frames"] == N and "vct_trace" in r.skipped
+    np.testing.assert_allclose(r.passes["Diffuse Indirect"], 2.0 * complete.passes["Diffuse Indirect"], rtol=1e-6)
+    # A change of the scene (the sun turned 10°), of the camera, and of the trace settings: each first frame
     # equals a fresh render of the new state (frame 0: the unturned cone set, i.e. accumulation off).
-    brighter = dataclasses.replace(scene, lights=[dataclasses.replace(scene.lights[0], power=8.0)])
-    moved = dataclasses.replace(brighter, camera=dataclasses.replace(
-        brighter.camera, matrix_world=brighter.camera.matrix_world @ np.array(
+    c, s_ = np.cos(np.radians(10.0)), np.sin(np.radians(10.0))
+    turn = np.array([[1, 0, 0, 0], [0, c, -s_, 0], [0, s_, c, 0], [0, 0, 0, 1.0]])
+    turned = dataclasses.replace(brighter, lights=[dataclasses.replace(sun, matrix_world=sun.matrix_world @ turn)])
+    moved = dataclasses.replace(turned, camera=dataclasses.replace(
+        turned.camera, matrix_world=turned.camera.matrix_world @ np.array(
             [[1, 0, 0, 0.1], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1.0]])))
     fresh = Engine()
-    for changed, s in ((brighter, settings), (moved, settings), (moved, _settings(temporal_frames=N, ao_distance=0.5))):
+    for changed, s in ((turned, settings), (moved, settings), (moved, _settings(temporal_frames=N, ao_distance=0.5))):
         r = engine.render(changed, s)
         assert r.info["temporal"]["frames"] == 1
         plain = fresh.render(changed, dataclasses.replace(s, vct=dataclasses.replace(s.vct, temporal_frames=0)))
