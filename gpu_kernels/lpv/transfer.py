@@ -98,6 +98,7 @@ class Transfer:
     normals: np.ndarray = None
     areas: np.ndarray = None
     updated: float = 1.0  # the share of T evaluated when it was made (1: all of it; less after an edit)
+    rows: np.ndarray = None  # receiver_rows: what the next geometry's receivers are compared with
 
     @property
     def nbytes(self) -> int:
@@ -133,7 +134,16 @@ def sorted_transfer(clusters: Clusters, matrix: np.ndarray, order: list, starts:
     if gv is None:
         return Transfer(clusters, matrix, order, starts, updated=updated)
     return Transfer(clusters, matrix, order, starts, grid, gv.cells.copy(), gv.axis.copy(), gv.surface_normal.copy(),
-                    gv.surface_area.copy(), updated)
+                    gv.surface_area.copy(), updated, receiver_rows(gv))
+
+
+def receiver_rows(gv) -> np.ndarray:
+    """(R, 17) float64 per receiver: its fine voxel, axis, normal, area, where its surfaces lie and the box they span
+    — what the kernel and the visibility planes read of it, so a receiver whose row is unchanged after an edit keeps
+    its pairs (lpv/transfer_update.py). A surface moved within its voxel keeps the first four, not the rest."""
+    lo, hi = gv.bounds
+    return np.concatenate([gv.cells.astype(np.float64), gv.axis[:, None], gv.surface_normal,
+                           gv.surface_area[:, None], gv.positions, lo, hi], axis=1)
 
 
 def spectral_radius(m: np.ndarray, iterations: int = 100) -> float:

@@ -17,7 +17,7 @@ import numpy as np
 from ..common.grid import Grid
 from ..gl.bind import dispatch, set_uniform
 from .clusters import Clusters, make_clusters
-from .transfer import cluster_order, kernel_program, sorted_transfer
+from .transfer import cluster_order, kernel_program, receiver_rows, sorted_transfer
 
 PAIRS_PER_DISPATCH = 1 << 20  # pairs evaluated per dispatch: 8 MiB read back, 16384 groups of 64
 # Sources per box_pairs dispatch: each invocation tests 32 receivers against each of them, and llvmpipe ends an
@@ -30,10 +30,9 @@ def update_transfer(ctx, programs, gv, grid: Grid, occlusion: bool, prior, limit
     evaluate would reach `limit` (build T anew instead)."""
     new = make_clusters(gv.cells, gv.surface_normal, gv.surface_area, gv.fine, 0, block=prior.clusters.block,
                         positions=gv.positions, bounds=gv.bounds)
-    before = _receivers(prior.cells, prior.axis, prior.normals, prior.areas)
-    after = _receivers(gv.cells, gv.axis, gv.surface_normal, gv.surface_area)
+    before, after = prior.rows, receiver_rows(gv)
     old_r = _match_receivers(before, after)
-    old_c = _match(prior.clusters.records, new.records)
+    old_c = _match(_cluster_rows(prior.clusters), _cluster_rows(new))
     gone = _match_receivers(after, before) < 0
     box = changed_box(np.concatenate([before[gone, :3], after[old_r < 0, :3]]), grid)
     fresh = (old_c < 0)[:, None] | (old_r < 0)[None, :]
@@ -134,13 +133,14 @@ def _match(old: np.ndarray, new: np.ndarray) -> np.ndarray:
     return np.array([old_keys.get(row.tobytes(), -1) for row in new], np.int64)
 
 
-def _receivers(cells, axis, normals, areas) -> np.ndarray:
-    """(R, 8) rows a receiver is compared by: its fine voxel, axis, normal and area."""
-    return np.concatenate([cells.astype(np.float64), axis[:, None], normals, areas[:, None]], axis=1)
+def _cluster_rows(clusters: Clusters) -> np.ndarray:
+    """(C, bytes) uint8 per cluster: its record and the octagon its surfaces span (the kernel's near field)."""
+    return np.concatenate([clusters.records.view(np.uint8).reshape(clusters.count, -1),
+                           np.ascontiguousarray(clusters.polygon).view(np.uint8).reshape(clusters.count, -1)], axis=1)
 
 
 def _match_receivers(old: np.ndarray, new: np.ndarray) -> np.ndarray:
-    """_match for _receivers rows, vectorised: a receiver is one (voxel, axis), so rows are paired by that key
+    """_match for transfer.receiver_rows, vectorised: a receiver is one (voxel, axis), so rows are paired by that key
     (sorted search) and then kept only where the whole row (normal, area) is equal."""
     def key(rows):
         c = rows[:, :4].astype(np.int64)

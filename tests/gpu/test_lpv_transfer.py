@@ -352,3 +352,25 @@ def test_skipping_empty_space_changes_no_visibility(monkeypatch, transport):
     walked = Engine().render(_room(), settings)
     assert _indirect(walked).max() > 0
     assert np.array_equal(_indirect(skipped), _indirect(walked))
+
+
+def _room_with_plate(z):
+    """The room of _room with a 0.6 m square plate (a table top, both sides) floating `z` m above the floor."""
+    quads = box_quads((-1, -1, 0), (1, 1, 2), 0, skip=((2, "hi"),)) + \
+        box_quads((-0.2, -0.2, z), (0.4, 0.4, z), 1, inward=False, skip=((0, "lo"), (0, "hi"), (1, "lo"), (1, "hi")))
+    bulb = np.eye(4)
+    bulb[:3, 3] = (-0.4, 0.2, 1.4)
+    return quad_scene(quads, [Material("floor", (0.7, 0.7, 0.7)), Material("plate", (0.8, 0.3, 0.2))],
+                      [Light("bulb", "POINT", (1, 1, 1), 60.0, bulb)], (0.0, -0.95, 1.0), (0.0, 0.5, 0.6),
+                      lens=12.0)
+
+
+def test_a_move_within_the_voxels_updates_the_pairs_it_moves():
+    """A plate lifted 1 cm, within its voxels: they keep their cells, normals and areas, but the surfaces lie
+    elsewhere in them (the receivers' positions, the clusters' records, the visibility planes), so the transfer's
+    update must still re-evaluate their pairs — it gives a cold render's result."""
+    engine = Engine()
+    engine.render(_room_with_plate(0.52), SETTINGS)
+    moved = engine.render(_room_with_plate(0.53), SETTINGS)
+    assert "lpv_transfer" in _rerun(moved) and moved.info["cascades"][0]["transfer_updated"] < 1.0
+    _same(_indirect(moved), _indirect(Engine().render(_room_with_plate(0.53), SETTINGS)))

@@ -152,7 +152,9 @@ def test_the_transport_is_capped_only_where_its_reflection_is_impossible():
     rng = np.random.default_rng(3)
     cells, normals, areas = _scene(_plane(2, 0, (0, 0), (40, 40)), _plane(0, 0, (0, 1), (40, 40)))
     c = cl.make_clusters(cells, normals, areas, FINE, budget=48)
-    gv = SimpleNamespace(cells=cells, axis=np.zeros(len(cells), np.int64), surface_normal=normals, surface_area=areas)
+    centres = (cells + 0.5) * FINE.cell
+    gv = SimpleNamespace(cells=cells, axis=np.zeros(len(cells), np.int64), surface_normal=normals, surface_area=areas,
+                         positions=centres, bounds=(centres - 0.5 * FINE.cell, centres + 0.5 * FINE.cell))
     weight = 0.8 * areas[:, None] * np.ones(3)
     # Light only on receiver sides that belong to a cluster (the others reflect nothing into M_ρ).
     raw = rng.uniform(0.5, 1.0, (2, c.count, len(cells))) * (c.side_cluster >= 0).T[:, None, :]
