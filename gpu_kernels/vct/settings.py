@@ -14,19 +14,21 @@ CONE_FIELDS = ("diffuse_cones", "diffuse_aperture", "max_distance", "step_multip
 @dataclass(frozen=True)
 class VctSettings:
     resolution: int = 64  # voxels along the longest axis of the scene (other axes padded, see vct_grid)
-    # A cap around the normal and one ring (5..9) or two rings (13, 16, … 31), cone_table. Default 9 with 7 sub-rays
-    # each (anisotropic volumes, vct/crossing.glsl), measured (64³, defaults otherwise, 160×120, against 2048-spp
-    # 8-bounce Cycles; Diffuse Indirect / Combined rel-L1, trace time 320×240 Cornell on llvmpipe):
-    #   9 cones × 7 sub-rays: Cornell 0.093 / 0.050, spot room 0.059 / 0.022, courtyard 0.080 / 0.059, 12 s;
-    #   9 × 5: 0.101 / 0.054, 0.062 / 0.023, 0.087 / 0.064, 7.5 s;  19 × 5: 0.080 / 0.045, 0.057 / 0.022, 0.072 /
-    #   0.053, 17 s;  19 × 7: 0.074 / 0.043, 0.058 / 0.022, 0.070 / 0.052, 25 s;  13 × 7: 0.093 / 0.051, 0.064 /
-    #   0.024, 0.077 / 0.057.
-    # (Before sub-rays, with the volumetric march: 19 cones 0.137 / 0.070, 0.131 / 0.048, 0.178 / 0.125, 2.3 s.)
-    diffuse_cones: int = 9
+    # A cap around the normal and one ring (5..9) or two rings (13, 16, … 31), cone_table, each cone a bundle of
+    # `subrays` rays (anisotropic volumes, vct/crossing.glsl). Default 16 × 5, measured 2026-12-06 (64³, defaults
+    # otherwise, 160×120, against 8-bounce Cycles; Diffuse Indirect / Combined rel-L1; the per-pixel trace on
+    # llvmpipe, Cornell): 9 × 7 (the default before): Cornell 0.101 / 0.051, spot room 0.052 / 0.019, courtyard
+    # 0.091 / 0.066, 0.68 s; 16 × 4: 0.098 / 0.049, 0.056 / 0.021, 0.089 / 0.065, 0.90 s; 16 × 5: 0.091 / 0.046,
+    # 0.050 / 0.019, 0.089 / 0.065, 1.05 s. On the scenes like users' (tests/support/examples_table.py) 9 × 7 missed
+    # two targets that 16 × 5 meets: many_lights' Combined 0.094 → 0.066 (a long hall: one ring of wide cones
+    # under-read the light its walls and floor bounce, 0.86 → 0.92 of Cycles'), metals' Diffuse Indirect 0.179 →
+    # 0.142; the others within 0.005 or closer to Cycles but lamp_room (Combined 0.047 → 0.052). 19 × 7: Cornell
+    # 0.074 / 0.043 in an earlier measure, at twice the trace of 9 × 7.
+    diffuse_cones: int = 16
     # Rays per diffuse cone in the per-pixel trace with anisotropic volumes (vct/crossing.glsl): the axis and
     # subrays − 1 around it; each meets surfaces where it crosses them. 1 = the axis only (9 cones: 0.202 / 0.102,
     # 0.099 / 0.036, 0.234 / 0.163). The trace's cost grows about linearly with it.
-    subrays: int = 7
+    subrays: int = 5
     # Cones per voxel face in the bounce gathers (vct/bounce.py); 0 = diffuse_cones. Bounced light is smooth, and
     # these gathers are most of a multi-bounce frame's time. Default 6, measured against 9 (64³, defaults otherwise,
     # Combined rel-L1 / bounce pass on llvmpipe): Cornell 0.092 vs 0.093 / 3.6 s vs 4.9 s, spot room 0.053 vs

@@ -323,7 +323,7 @@ def test_settings_are_validated(bad):
 
 def test_defaults_are_valid_and_keys_separate_passes():
     s = VctSettings()
-    assert s.resolution == 64 and s.diffuse_cones == 9 and s.subrays == 7 and s.bounces == 8
+    assert s.resolution == 64 and s.diffuse_cones == 16 and s.subrays == 5 and s.bounces == 8
     assert s.gathered_bounces == 4
     assert s.anisotropic and s.bounce_cones == 6
     for change in (dict(bounces=3), dict(gathered_bounces=2), dict(bounce_cones=9), dict(epsilon=0.01)):
@@ -337,7 +337,7 @@ def test_defaults_are_valid_and_keys_separate_passes():
     assert VctSettings(diffuse_cones=19, bounce_cones=0).key("bounce") != VctSettings(bounce_cones=0).key("bounce")
     assert s.specular_cone  # on by default: pixels with no glossy closure skip it (vct/specular.py)
     assert s.indirect_scale == 2  # the diffuse cones at every other pixel, upsampled (vct/upsample.py)
-    for change in (dict(indirect_scale=1), dict(temporal_frames=4), dict(cone_rotation=10.0), dict(subrays=5)):
+    for change in (dict(indirect_scale=1), dict(temporal_frames=4), dict(cone_rotation=10.0), dict(subrays=7)):
         assert VctSettings(**change).key("trace") != s.key("trace") and VctSettings(**change).key("specular") == \
             s.key("specular") and VctSettings(**change).key("bounce") == s.key("bounce")
     assert VctSettings(roughness_cutoff=0.2).key("specular") != s.key("specular")
