@@ -19,7 +19,7 @@ from ..gl.bind import dispatch, set_uniform
 from .clusters import Clusters, make_clusters
 from .transfer import cluster_order, kernel_program, receiver_rows, sorted_transfer
 
-PAIRS_PER_DISPATCH = 1 << 20  # pairs evaluated per dispatch: 8 MiB read back, 16384 groups of 64
+PAIRS_PER_DISPATCH = 1 << 20  # pairs evaluated per dispatch and listed at a time: 8 MiB read back, 16384 groups
 # Sources per box_pairs dispatch: each invocation tests 32 receivers against each of them, and llvmpipe ends an
 # invocation's loops after 65535 iterations in all (lpv/gather.vpls_per_dispatch).
 MASK_SOURCES = 1024
@@ -38,23 +38,42 @@ def update_transfer(ctx, programs, gv, grid: Grid, occlusion: bool, prior, limit
     fresh = (old_c < 0)[:, None] | (old_r < 0)[None, :]
     if box is not None:
         fresh |= box_pairs(ctx, programs, gv, new, box)
-    sources, receivers = np.nonzero(fresh)
-    del fresh
-    share = len(sources) / max(new.count * int(gv.surface_count), 1)
+    per_source = np.count_nonzero(fresh, axis=1)
+    share = int(per_source.sum()) / max(fresh.size, 1)
     if share >= limit:
         return None
-    values = evaluate_pairs(ctx, programs, gv, grid, new, occlusion, sources, receivers)
     order, starts = cluster_order(new)
+    columns = []
     matrix = np.empty((2, new.count, int(gv.surface_count)), np.float32)
     for side in range(2):  # columns in the new clusters' order: the kept pairs' old values, then the fresh ones
         old_column = np.empty(len(prior.order[side]), np.int64)
         old_column[prior.order[side]] = np.arange(len(old_column))
-        column = np.empty(len(order[side]), np.int64)
-        column[order[side]] = np.arange(len(column))
+        columns.append(np.empty(len(order[side]), np.int64))
+        columns[side][order[side]] = np.arange(len(order[side]))
         rows = np.take(prior.matrix[side], np.maximum(old_c, 0), axis=0)
         take_columns(rows, old_column[np.maximum(old_r[order[side]], 0)], matrix[side])
-        matrix[side][sources, column[receivers]] = values[:, side]
+    for first, last in source_chunks(per_source, PAIRS_PER_DISPATCH):  # the pair lists a chunk at a time
+        sources, receivers = np.nonzero(fresh[first:last])
+        sources += first
+        values = evaluate_pairs(ctx, programs, gv, grid, new, occlusion, sources, receivers)
+        for side in range(2):
+            matrix[side][sources, columns[side][receivers]] = values[:, side]
     return sorted_transfer(new, matrix, order, starts, gv, grid, share)
+
+
+def source_chunks(counts: np.ndarray, most: int) -> list:
+    """[first, last) ranges of consecutive sources whose pairs (`counts` per source) add up to at most `most` each
+    (or one source, if it alone has more): an update's pair list is made and evaluated one range at a time, so its
+    host memory stays a few tens of MiB however large T is."""
+    out, first, total = [], 0, 0
+    for i, n in enumerate(counts):
+        if total and total + n > most:
+            out.append((first, i))
+            first, total = i, 0
+        total += int(n)
+    if total:
+        out.append((first, len(counts)))
+    return out
 
 
 def take_columns(src: np.ndarray, columns: np.ndarray, out: np.ndarray) -> None:

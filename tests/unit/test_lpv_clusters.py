@@ -189,3 +189,14 @@ def test_take_columns_is_a_column_gather(runs):
     out = np.empty((7, len(columns)), np.float32)
     take_columns(src, columns, out)
     assert np.array_equal(out, np.take(src, columns, axis=1))
+
+
+def test_source_chunks_cover_every_source_once_within_the_budget():
+    """transfer_update.source_chunks: consecutive ranges, each at most `most` pairs unless one source alone has
+    more, together every source with pairs."""
+    from bounce_gi.gpu_kernels.lpv.transfer_update import source_chunks
+    counts = np.array([3, 0, 4, 2, 9, 1, 1, 0, 0])
+    chunks = source_chunks(counts, 5)
+    assert chunks == [(0, 2), (2, 3), (3, 4), (4, 5), (5, 9)]
+    assert all(counts[a:b].sum() <= 5 or b - a == 1 for a, b in chunks)
+    assert source_chunks(np.zeros(4, int), 5) == []
