@@ -22,8 +22,11 @@ class VctSettings:
     # 0.050 / 0.019, 0.089 / 0.065, 1.05 s. On the scenes like users' (tests/support/examples_table.py) 9 × 7 missed
     # two targets that 16 × 5 meets: many_lights' Combined 0.094 → 0.066 (a long hall: one ring of wide cones
     # under-read the light its walls and floor bounce, 0.86 → 0.92 of Cycles'), metals' Diffuse Indirect 0.179 →
-    # 0.142; the others within 0.005 or closer to Cycles but lamp_room (Combined 0.047 → 0.052). 19 × 7: Cornell
-    # 0.074 / 0.043 in an earlier measure, at twice the trace of 9 × 7.
+    # 0.142; the others within 0.005 or closer to Cycles but lamp_room (Combined 0.047 → 0.052). Against an exact
+    # view factor (tests/gpu/test_vct.py, a lit patch seen from a plate and a wall) 16 × 5 reads 1.07× where 9 × 7
+    # read 0.96–1.01 and 19 × 4 (as fast as 16 × 5) 1.03–1.05, which met the same two targets with the scenes a
+    # little further from Cycles (outdoor 0.239 against 0.219). 19 × 7: Cornell 0.074 / 0.043 in an earlier measure,
+    # at twice the trace of 9 × 7.
     diffuse_cones: int = 16
     # Rays per diffuse cone in the per-pixel trace with anisotropic volumes (vct/crossing.glsl): the axis and
     # subrays − 1 around it; each meets surfaces where it crosses them. 1 = the axis only (9 cones: 0.202 / 0.102,
