@@ -268,8 +268,8 @@ class Pipeline:
         geometry = cache.run("geometry", (keys["geometry"],), lambda: geo.upload_geometry(ctx, programs, scene))
         textures = cache.run("textures", (keys["materials"],), lambda: geo.upload_textures(ctx, scene))
         # Closed emitters trap their inner light unless the camera is inside one (common/emitters.py): the shells
-        # depend on geometry and the materials' emission only, and the shadow maps on which of them hold the camera, which
-        # changes only when the camera crosses one.
+        # depend on geometry and the materials' emission only, and the shadow maps on which of them hold the camera,
+        # which changes only when the camera crosses one.
         shells = cache.run("emitter_shells", (keys["geometry"], keys["emission"]), lambda: em.sealed_shells(scene))
         camera = None if scene.camera is None else np.asarray(scene.camera.matrix_world, np.float64)[:3, 3]
         around = em.shells_around(scene, shells, camera)

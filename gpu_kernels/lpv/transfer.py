@@ -66,20 +66,32 @@ def build_transfer(ctx, programs, gv, grid: Grid, clusters: Clusters, occlusion:
         return out
     prog, buffers = kernel_program(ctx, programs, gv, grid, clusters, occlusion)
     chunk = max(1, min(vpls_per_dispatch(grid), ROWS_BYTES // (8 * r)))
-    rows = ctx.buffer(reserve=min(chunk, c) * r * 8)
-    rows.bind_to_storage_buffer(8)
-    for first in range(0, c, chunk):
-        count = min(chunk, c - first)
-        set_uniform(prog, "u_vpl_first", first)
-        set_uniform(prog, "u_vpl_count", count)
-        dispatch(prog, (r,), local=64)
-        ctx.memory_barrier()
-        block = np.frombuffer(rows.read(size=count * r * 8), np.float32).reshape(count, r, 2)
+    for first, count, data in dispatch_in_runs(ctx, prog, c, chunk, r, 8 * r):
+        block = np.frombuffer(data, np.float32).reshape(count, r, 2)
         out[0, first:first + count] = block[..., 0]
         out[1, first:first + count] = block[..., 1]
-    for buffer in buffers + [rows]:
+    for buffer in buffers:
         buffer.release()
     return out
+
+
+def dispatch_in_runs(ctx, prog, total: int, run: int, invocations: int, item_bytes: int, names=("u_vpl_first",
+                     "u_vpl_count")):
+    """Yield (first, count, bytes) for each run of at most `run` of `total` items: `prog` dispatched over
+    `invocations` (groups of 64; 0: one per item of the run) with the run's first item and count in the uniforms
+    `names`, and what it wrote to storage buffer 8 (count × `item_bytes`, a buffer made for the loop) read back."""
+    out = ctx.buffer(reserve=max(1, min(run, total)) * item_bytes)
+    out.bind_to_storage_buffer(8)
+    try:
+        for first in range(0, total, run):
+            count = min(run, total - first)
+            set_uniform(prog, names[0], first)
+            set_uniform(prog, names[1], count)
+            dispatch(prog, (invocations if invocations else count,), local=64)
+            ctx.memory_barrier()
+            yield first, count, out.read(size=count * item_bytes)
+    finally:
+        out.release()
 
 
 @dataclass
@@ -129,12 +141,13 @@ def sort_by_cluster(clusters: Clusters, matrix: np.ndarray, gv=None, grid: Grid 
 
 
 def sorted_transfer(clusters: Clusters, matrix: np.ndarray, order: list, starts: list, gv=None,
-                    grid: Grid | None = None, updated: float = 1.0) -> Transfer:
-    """A Transfer of `matrix` whose columns are already in cluster_order's `order`."""
+                    grid: Grid | None = None, updated: float = 1.0, rows: np.ndarray | None = None) -> Transfer:
+    """A Transfer of `matrix` whose columns are already in cluster_order's `order` (`rows`: receiver_rows(gv),
+    where the caller has them)."""
     if gv is None:
         return Transfer(clusters, matrix, order, starts, updated=updated)
     return Transfer(clusters, matrix, order, starts, grid, gv.cells.copy(), gv.axis.copy(), gv.surface_normal.copy(),
-                    gv.surface_area.copy(), updated, receiver_rows(gv))
+                    gv.surface_area.copy(), updated, receiver_rows(gv) if rows is None else rows)
 
 
 def receiver_rows(gv) -> np.ndarray:

@@ -15,9 +15,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..common.grid import Grid
-from ..gl.bind import dispatch, set_uniform
+from ..gl.bind import set_uniform
 from .clusters import Clusters, make_clusters
-from .transfer import cluster_order, kernel_program, receiver_rows, sorted_transfer
+from .transfer import cluster_order, dispatch_in_runs, kernel_program, receiver_rows, sorted_transfer
 
 PAIRS_PER_DISPATCH = 1 << 20  # pairs evaluated per dispatch and listed at a time: 8 MiB read back, 16384 groups
 # Sources per box_pairs dispatch: each invocation tests 32 receivers against each of them, and llvmpipe ends an
@@ -58,7 +58,7 @@ def update_transfer(ctx, programs, gv, grid: Grid, occlusion: bool, prior, limit
         values = evaluate_pairs(ctx, programs, gv, grid, new, occlusion, sources, receivers)
         for side in range(2):
             matrix[side][sources, columns[side][receivers]] = values[:, side]
-    return sorted_transfer(new, matrix, order, starts, gv, grid, share)
+    return sorted_transfer(new, matrix, order, starts, gv, grid, share, after)
 
 
 def source_chunks(counts: np.ndarray, most: int) -> list:
@@ -102,22 +102,14 @@ def box_pairs(ctx, programs, gv, clusters: Clusters, box: np.ndarray) -> np.ndar
     sources = ctx.buffer(clusters.records.tobytes())
     sources.bind_to_storage_buffer(6)
     gv.receivers.bind_to_storage_buffer(10)
-    mask = ctx.buffer(reserve=min(MASK_SOURCES, c) * words * 4)
-    mask.bind_to_storage_buffer(8)
     set_uniform(prog, "u_surface_count", r)
     set_uniform(prog, "u_words", words)
     set_uniform(prog, "u_box_lo", tuple(float(v) for v in box[0]))
     set_uniform(prog, "u_box_hi", tuple(float(v) for v in box[1]))
-    for first in range(0, c, MASK_SOURCES):
-        count = min(MASK_SOURCES, c - first)
-        set_uniform(prog, "u_vpl_first", first)
-        set_uniform(prog, "u_vpl_count", count)
-        dispatch(prog, (words,), local=64)
-        ctx.memory_barrier()
-        bits = np.frombuffer(mask.read(size=count * words * 4), np.uint32).reshape(count, words)
+    for first, count, data in dispatch_in_runs(ctx, prog, c, MASK_SOURCES, words, 4 * words):
+        bits = np.frombuffer(data, np.uint32).reshape(count, words)
         out[first:first + count] = np.unpackbits(bits.view(np.uint8), axis=1, bitorder="little")[:, :r]
     sources.release()
-    mask.release()
     return out
 
 
@@ -132,16 +124,10 @@ def evaluate_pairs(ctx, programs, gv, grid: Grid, clusters: Clusters, occlusion:
     pairs[:, 0], pairs[:, 1] = sources, receivers
     pairs = ctx.buffer(pairs.tobytes())
     pairs.bind_to_storage_buffer(11)
-    rows = ctx.buffer(reserve=min(PAIRS_PER_DISPATCH, len(sources)) * 8)
-    rows.bind_to_storage_buffer(8)
-    for first in range(0, len(sources), PAIRS_PER_DISPATCH):
-        count = min(PAIRS_PER_DISPATCH, len(sources) - first)
-        set_uniform(prog, "u_pair_first", first)
-        set_uniform(prog, "u_pair_count", count)
-        dispatch(prog, (count,), local=64)
-        ctx.memory_barrier()
-        out[first:first + count] = np.frombuffer(rows.read(size=count * 8), np.float32).reshape(count, 2)
-    for buffer in buffers + [pairs, rows]:
+    for first, count, data in dispatch_in_runs(ctx, prog, len(sources), PAIRS_PER_DISPATCH, 0, 8,
+                                               ("u_pair_first", "u_pair_count")):
+        out[first:first + count] = np.frombuffer(data, np.float32).reshape(count, 2)
+    for buffer in buffers + [pairs]:
         buffer.release()
     return out
 
