@@ -106,13 +106,19 @@ from examples import references  # noqa: E402
 # before, about the same trace time): Diffuse Indirect metals 0.179 -> 0.142 and many_lights' Combined 0.094 -> 0.066
 # (both targets met now), many_lights' Diffuse Indirect 0.148 -> 0.093 (0.86 -> 0.92 of Cycles'), outdoor 0.239 ->
 # 0.219, default_principled 0.084 -> 0.072; worse: lamp_room Diffuse Indirect 0.080 -> 0.087, Combined 0.047 -> 0.052.
+# 2026-12-06 (stop 42): the LPV rows re-measured after a cell holding flat axis-facing layers of two or three axes (a
+# floor and the foot of a wall) stopped being taken for their mean plane, tilted across the corner (lpv/crossings.py;
+# tests/gpu/test_lpv_junctions.py: the floor at a block's foot 0.30 -> 0.999 of its view factor). Diffuse Indirect
+# (DI / Cycles): many_lights 0.065 -> 0.056, furnished 0.110 -> 0.101, metals 0.201 -> 0.197; worse: thin_walls 0.045
+# -> 0.054 (1.01 -> 1.04 of Cycles': dark lines along its floors' junctions had hidden light too bright elsewhere),
+# outdoor 0.227 -> 0.234; the others within 0.001.
 BOUNDS = {
     'default_principled': {
-        'lpv': {'Combined': 0.050, 'Diffuse Direct': 0.008, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.010, 'Glossy Indirect': 0.530, 'Glossy Color': 0.020, 'Diffuse Light': 0.046, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.047, 'Diffuse Direct': 0.008, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.010, 'Glossy Indirect': 0.522, 'Glossy Color': 0.020, 'Diffuse Light': 0.045, 'Diffuse Color match': 0.998},
         'vct': {'Combined': 0.037, 'Diffuse Direct': 0.008, 'Diffuse Indirect': 0.114, 'Diffuse Color': 0.003, 'Glossy Direct': 0.010, 'Glossy Indirect': 0.385, 'Glossy Color': 0.020, 'Diffuse Light': 0.033, 'Diffuse Color match': 0.998},
     },
     'metals': {
-        'lpv': {'Combined': 0.057, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.266, 'Diffuse Color': 0.003, 'Glossy Direct': 0.032, 'Glossy Indirect': 0.627, 'Glossy Color': 0.013, 'Diffuse Light': 0.027, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.057, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.262, 'Diffuse Color': 0.003, 'Glossy Direct': 0.032, 'Glossy Indirect': 0.625, 'Glossy Color': 0.013, 'Diffuse Light': 0.027, 'Diffuse Color match': 0.998},
         'vct': {'Combined': 0.044, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.032, 'Glossy Indirect': 0.536, 'Glossy Color': 0.013, 'Diffuse Light': 0.025, 'Diffuse Color match': 0.998},
     },
     'textured': {
@@ -120,7 +126,7 @@ BOUNDS = {
         'vct': {'Combined': 0.020, 'Diffuse Direct': 0.002, 'Diffuse Indirect': 0.139, 'Diffuse Color': 0.002, 'Diffuse Light': 0.019, 'Diffuse Color match': 0.998},
     },
     'window_room': {
-        'lpv': {'Combined': 0.080, 'Diffuse Direct': 0.066, 'Diffuse Indirect': 0.099, 'Diffuse Color': 0.003, 'Glossy Direct': 0.100, 'Glossy Indirect': 0.238, 'Glossy Color': 0.018, 'Diffuse Light': 0.071, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.078, 'Diffuse Direct': 0.066, 'Diffuse Indirect': 0.099, 'Diffuse Color': 0.003, 'Glossy Direct': 0.100, 'Glossy Indirect': 0.243, 'Glossy Color': 0.018, 'Diffuse Light': 0.069, 'Diffuse Color match': 0.998},
         'vct': {'Combined': 0.077, 'Diffuse Direct': 0.066, 'Diffuse Indirect': 0.098, 'Diffuse Color': 0.003, 'Glossy Direct': 0.100, 'Glossy Indirect': 0.201, 'Glossy Color': 0.018, 'Diffuse Light': 0.070, 'Diffuse Color match': 0.998},
     },
     'rug_room': {
@@ -128,7 +134,7 @@ BOUNDS = {
         'vct': {'Combined': 0.070, 'Diffuse Direct': 0.003, 'Diffuse Indirect': 0.140, 'Diffuse Color': 0.002, 'Glossy Direct': 0.016, 'Glossy Indirect': 0.261, 'Glossy Color': 0.020, 'Diffuse Light': 0.061, 'Diffuse Color match': 0.998},
     },
     'thin_walls': {
-        'lpv': {'Combined': 0.062, 'Diffuse Direct': 0.096, 'Diffuse Indirect': 0.079, 'Diffuse Color': 0.002, 'Glossy Direct': 0.235, 'Glossy Indirect': 0.338, 'Glossy Color': 0.025, 'Diffuse Light': 0.066, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.061, 'Diffuse Direct': 0.096, 'Diffuse Indirect': 0.089, 'Diffuse Color': 0.002, 'Glossy Direct': 0.235, 'Glossy Indirect': 0.349, 'Glossy Color': 0.025, 'Diffuse Light': 0.062, 'Diffuse Color match': 0.998},
         'vct': {'Combined': 0.071, 'Diffuse Direct': 0.096, 'Diffuse Indirect': 0.075, 'Diffuse Color': 0.002, 'Glossy Direct': 0.235, 'Glossy Indirect': 0.247, 'Glossy Color': 0.025, 'Diffuse Light': 0.072, 'Diffuse Color match': 0.998},
     },
     'lamp_room': {
@@ -136,11 +142,11 @@ BOUNDS = {
         'vct': {'Combined': 0.080, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.002, 'Glossy Direct': 0.033, 'Glossy Indirect': 0.384, 'Glossy Color': 0.017, 'Emission': 0.002, 'Diffuse Light': 0.135, 'Diffuse Color match': 0.998},
     },
     'many_lights': {
-        'lpv': {'Combined': 0.072, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.108, 'Diffuse Color': 0.004, 'Glossy Direct': 0.057, 'Glossy Indirect': 0.214, 'Glossy Color': 0.032, 'Diffuse Light': 0.074, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.065, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.098, 'Diffuse Color': 0.004, 'Glossy Direct': 0.057, 'Glossy Indirect': 0.212, 'Glossy Color': 0.032, 'Diffuse Light': 0.067, 'Diffuse Color match': 0.998},
         'vct': {'Combined': 0.080, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.135, 'Diffuse Color': 0.004, 'Glossy Direct': 0.057, 'Glossy Indirect': 0.224, 'Glossy Color': 0.032, 'Diffuse Light': 0.093, 'Diffuse Color match': 0.998},
     },
     'outdoor': {
-        'lpv': {'Combined': 0.047, 'Diffuse Direct': 0.016, 'Diffuse Indirect': 0.262, 'Diffuse Color': 0.003, 'Glossy Direct': 0.048, 'Glossy Indirect': 0.614, 'Glossy Color': 0.033, 'Diffuse Light': 0.027, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.048, 'Diffuse Direct': 0.016, 'Diffuse Indirect': 0.269, 'Diffuse Color': 0.003, 'Glossy Direct': 0.048, 'Glossy Indirect': 0.625, 'Glossy Color': 0.033, 'Diffuse Light': 0.027, 'Diffuse Color match': 0.998},
         'vct': {'Combined': 0.046, 'Diffuse Direct': 0.016, 'Diffuse Indirect': 0.254, 'Diffuse Color': 0.003, 'Glossy Direct': 0.048, 'Glossy Indirect': 0.679, 'Glossy Color': 0.033, 'Diffuse Light': 0.026, 'Diffuse Color match': 0.998},
     },
     'product_shot': {
@@ -148,7 +154,7 @@ BOUNDS = {
         'vct': {'Combined': 0.041, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.034, 'Glossy Indirect': 0.486, 'Glossy Color': 0.016, 'Diffuse Light': 0.039, 'Diffuse Color match': 0.996},
     },
     'furnished': {
-        'lpv': {'Combined': 0.080, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.035, 'Glossy Indirect': 0.254, 'Glossy Color': 0.025, 'Emission': 0.009, 'Diffuse Light': 0.089, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.079, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.035, 'Glossy Indirect': 0.250, 'Glossy Color': 0.025, 'Emission': 0.009, 'Diffuse Light': 0.084, 'Diffuse Color match': 0.998},
         'vct': {'Combined': 0.074, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.134, 'Diffuse Color': 0.003, 'Glossy Direct': 0.035, 'Glossy Indirect': 0.232, 'Glossy Color': 0.025, 'Emission': 0.009, 'Diffuse Light': 0.076, 'Diffuse Color match': 0.998},
     },
     'cornell_animated': {

@@ -49,20 +49,29 @@ def box_quads(lo, hi, material, inward=True, skip=()):
     return out
 
 
-def patch_view_factor(points, normals, patch, radiance, m=120):
-    """Exact irradiance / π at `points` (normals) from a Lambertian floor rectangle (x0, x1, y0, y1) at z = 0 of
-    `radiance`, unoccluded: midpoint rule over m × m cells."""
-    x0, x1, y0, y1 = patch
+def rectangle_view_factor(points, normals, corner, edge_u, edge_v, m=120):
+    """Exact view factors from `points` (normals) to the Lambertian rectangle corner + s·edge_u + t·edge_v, s, t in
+    [0, 1], seen from the side its normal edge_u × edge_v faces, unoccluded: midpoint rule over m × m cells."""
+    corner, edge_u, edge_v = (np.asarray(a, float) for a in (corner, edge_u, edge_v))
+    facing = np.cross(edge_u, edge_v)
+    area = float(np.linalg.norm(facing))
     u = (np.arange(m) + 0.5) / m
-    gx, gy = np.meshgrid(x0 + (x1 - x0) * u, y0 + (y1 - y0) * u)
-    q = np.stack([gx, gy, np.zeros_like(gx)], -1).reshape(-1, 3)
+    s, t = np.meshgrid(u, u)
+    q = corner + s.reshape(-1, 1) * edge_u + t.reshape(-1, 1) * edge_v
     out = []
     for p, n in zip(points, normals):
         v = q - p
         r2 = (v * v).sum(-1)
-        cos_p, cos_q = np.clip(v @ n, 0, None) / np.sqrt(r2), np.clip(-v[:, 2], 0, None) / np.sqrt(r2)
-        out.append(radiance * (cos_p * cos_q / r2).sum() * (x1 - x0) * (y1 - y0) / m ** 2 / math.pi)
+        cos_p, cos_q = np.clip(v @ n, 0, None) / np.sqrt(r2), np.clip(-(v @ facing) / area, 0, None) / np.sqrt(r2)
+        out.append((cos_p * cos_q / r2).sum() * area / m ** 2 / math.pi)
     return np.array(out)
+
+
+def patch_view_factor(points, normals, patch, radiance, m=120):
+    """Exact irradiance / π at `points` (normals) from a Lambertian floor rectangle (x0, x1, y0, y1) at z = 0 of
+    `radiance`, unoccluded (rectangle_view_factor)."""
+    x0, x1, y0, y1 = patch
+    return radiance * rectangle_view_factor(points, normals, (x0, y0, 0.0), (x1 - x0, 0.0, 0.0), (0.0, y1 - y0, 0.0), m)
 
 
 LIT_PATCH = (-1.5, 1.5, -1.25, 1.25)  # x0, x1, y0, y1 of the sunlit patch (albedo 0.7, sun 2 W/m² at 60°)
