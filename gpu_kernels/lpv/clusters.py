@@ -214,7 +214,7 @@ def make_clusters(cells: np.ndarray, normals: np.ndarray, areas: np.ndarray, fin
     return Clusters(block, sides.reshape(-1, 2), records, key[first], offsets, box, polygon, fine, lo, hi)
 
 
-AXIS_PLANE = 0.985  # cos 10°: a cluster whose normal lies this near an axis lies in that axis' plane
+AXIS_PLANE = 0.985  # cos 10°: a cluster whose normal lies this near an axis takes that axis' plane as its frame
 PLANAR = 0.985  # a cluster whose sides' area-weighted mean normal is this long (10° of spread) lies in one plane
 
 
@@ -231,7 +231,11 @@ def polygons(records: np.ndarray, mean_normal: np.ndarray, index: np.ndarray, lo
     its span); the octagon is where the pieces' spans along the frame's axes and its two diagonals hold (an
     8-DOP): a rectangle where the surfaces fill one; where a wall at an angle cuts a block of floor, its diagonal
     edge keeps most of the floor's rectangle that lies beyond the wall out (a rectangle there put 4% of the floor's
-    light on the wall's outside in a closed box turned 30°)."""
+    light on the wall's outside in a closed box turned 30°).
+
+    Planar only where the sides' normals agree (PLANAR), whatever axis their mean lies along: the inside of a
+    sphere's top, a cap whose mean normal is −z, spans in its mean plane a square wider than the sphere there, and
+    as that square it lit the outside of the sphere's top from within (tests/gpu/test_lpv_near_field.py)."""
     count = len(records)
     unit = records["normal"][:, :3].astype(np.float64)
     dominant = np.argmax(np.abs(unit), axis=1)
@@ -262,7 +266,7 @@ def polygons(records: np.ndarray, mean_normal: np.ndarray, index: np.ndarray, lo
     base = centroid - sum(np.einsum("ij,ij->i", centroid, t)[:, None] * t for t in (t1, t2))  # the plane's foot
     out = np.zeros((count, 8, 4), np.float32)
     out[..., :3] = base[:, None] + corners[..., :1] * t1[:, None] + corners[..., 1:] * t2[:, None]
-    planar = axis_plane | (np.linalg.norm(mean_normal, axis=1) >= PLANAR)
+    planar = np.linalg.norm(mean_normal, axis=1) >= PLANAR  # not axis_plane: a cap's mean normal can be an axis
     out[:, 0, 3] = planar & (area > 1e-6 * cell * cell)
     out[:, 1, 3] = area
     return out

@@ -9,7 +9,7 @@ alone would turn a sphere into a staircase that rays leaving it at a grazing ang
 put a diagonal wall across every corner. So a cell whose surfaces face along the axes and lie in two or three flat
 axis layers (a floor and the foot of a wall, where the cell holds little of the wall) is axis planes even where its
 normals pass PLANAR: as their mean plane, tilted across the corner, it stopped the light between the floor and the
-wall — a block's face lit the floor at its foot with 0.30 of the exact view factor (tests/gpu/test_lpv_junctions.py).
+wall — a block's face lit the floor at its foot with 0.30 of the exact view factor (tests/gpu/test_lpv_near_field.py).
 
 Along each plane direction the cell's surfaces form one layer, at their mean coordinate, or two, at their nearest
 and farthest coordinates, where every surface lies at one or the other and those lie more than LAYER_GAP apart (the

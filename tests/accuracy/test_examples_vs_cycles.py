@@ -108,21 +108,25 @@ from examples import references  # noqa: E402
 # 0.219, default_principled 0.084 -> 0.072; worse: lamp_room Diffuse Indirect 0.080 -> 0.087, Combined 0.047 -> 0.052.
 # 2026-12-06 (stop 42): the LPV rows re-measured after a cell holding flat axis-facing layers of two or three axes (a
 # floor and the foot of a wall) stopped being taken for their mean plane, tilted across the corner (lpv/crossings.py;
-# tests/gpu/test_lpv_junctions.py: the floor at a block's foot 0.30 -> 0.999 of its view factor). Diffuse Indirect
+# tests/gpu/test_lpv_near_field.py: the floor at a block's foot 0.30 -> 0.999 of its view factor). Diffuse Indirect
 # (DI / Cycles): many_lights 0.065 -> 0.056, furnished 0.110 -> 0.101, metals 0.201 -> 0.197; worse: thin_walls 0.045
 # -> 0.054 (1.01 -> 1.04 of Cycles': dark lines along its floors' junctions had hidden light too bright elsewhere),
-# outdoor 0.227 -> 0.234; the others within 0.001.
+# outdoor 0.227 -> 0.234; the others within 0.001. Then a cluster whose mean normal lies along an axis stopped being
+# taken as flat whatever its normals' spread (lpv/clusters.py polygons: a curved cap, as a square in its mean plane,
+# lit the outside of its own surface from within): metals 0.197 -> 0.167 (1.14 -> 1.09 of Cycles'),
+# default_principled 0.125 -> 0.120; worse: product_shot 0.100 -> 0.106 (its curved backdrop's clusters as quarter
+# discs), textured 0.065 -> 0.068.
 BOUNDS = {
     'default_principled': {
-        'lpv': {'Combined': 0.047, 'Diffuse Direct': 0.008, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.010, 'Glossy Indirect': 0.522, 'Glossy Color': 0.020, 'Diffuse Light': 0.045, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.047, 'Diffuse Direct': 0.008, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.010, 'Glossy Indirect': 0.521, 'Glossy Color': 0.020, 'Diffuse Light': 0.044, 'Diffuse Color match': 0.998},
         'vct': {'Combined': 0.037, 'Diffuse Direct': 0.008, 'Diffuse Indirect': 0.114, 'Diffuse Color': 0.003, 'Glossy Direct': 0.010, 'Glossy Indirect': 0.385, 'Glossy Color': 0.020, 'Diffuse Light': 0.033, 'Diffuse Color match': 0.998},
     },
     'metals': {
-        'lpv': {'Combined': 0.057, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.262, 'Diffuse Color': 0.003, 'Glossy Direct': 0.032, 'Glossy Indirect': 0.625, 'Glossy Color': 0.013, 'Diffuse Light': 0.027, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.057, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.231, 'Diffuse Color': 0.003, 'Glossy Direct': 0.032, 'Glossy Indirect': 0.628, 'Glossy Color': 0.013, 'Diffuse Light': 0.025, 'Diffuse Color match': 0.998},
         'vct': {'Combined': 0.044, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.032, 'Glossy Indirect': 0.536, 'Glossy Color': 0.013, 'Diffuse Light': 0.025, 'Diffuse Color match': 0.998},
     },
     'textured': {
-        'lpv': {'Combined': 0.015, 'Diffuse Direct': 0.002, 'Diffuse Indirect': 0.110, 'Diffuse Color': 0.002, 'Diffuse Light': 0.015, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.016, 'Diffuse Direct': 0.002, 'Diffuse Indirect': 0.112, 'Diffuse Color': 0.002, 'Diffuse Light': 0.016, 'Diffuse Color match': 0.998},
         'vct': {'Combined': 0.020, 'Diffuse Direct': 0.002, 'Diffuse Indirect': 0.139, 'Diffuse Color': 0.002, 'Diffuse Light': 0.019, 'Diffuse Color match': 0.998},
     },
     'window_room': {
@@ -150,7 +154,7 @@ BOUNDS = {
         'vct': {'Combined': 0.046, 'Diffuse Direct': 0.016, 'Diffuse Indirect': 0.254, 'Diffuse Color': 0.003, 'Glossy Direct': 0.048, 'Glossy Indirect': 0.679, 'Glossy Color': 0.033, 'Diffuse Light': 0.026, 'Diffuse Color match': 0.998},
     },
     'product_shot': {
-        'lpv': {'Combined': 0.041, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.034, 'Glossy Indirect': 0.604, 'Glossy Color': 0.016, 'Diffuse Light': 0.035, 'Diffuse Color match': 0.996},
+        'lpv': {'Combined': 0.041, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.034, 'Glossy Indirect': 0.611, 'Glossy Color': 0.016, 'Diffuse Light': 0.036, 'Diffuse Color match': 0.996},
         'vct': {'Combined': 0.041, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.034, 'Glossy Indirect': 0.486, 'Glossy Color': 0.016, 'Diffuse Light': 0.039, 'Diffuse Color match': 0.996},
     },
     'furnished': {

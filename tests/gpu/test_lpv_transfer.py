@@ -303,7 +303,7 @@ def test_light_inside_a_pillar_thinner_than_a_cell_stays_mostly_inside():
     0.14 of what the same light gives outside the pillar (0.38 before); the rest leaks where a fine voxel holds the
     floor or the ceiling on both sides of a face, one receiver and one cluster across it. 0.25 since the room's
     ceiling–wall junctions no longer stand as planes tilted across their corners (lpv/crossings.py: they stopped the
-    light between the ceiling and the walls, this leak's with it; test_lpv_junctions.py). Bound 0.27: the render is
+    light between the ceiling and the walls, this leak's with it; test_lpv_near_field.py). Bound 0.27: the render is
     deterministic, two points for other drivers' rounding; the pillar's faces as one mean plane (0.38) fail it."""
     means = []
     for x in (0.0, 1.0):
