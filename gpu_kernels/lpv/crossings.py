@@ -6,10 +6,11 @@ A cell whose surfaces are one plane (the area-weighted normal tensor Σ A·n·n�
 trace ≥ PLANAR: a wall, a floor, a patch of a sphere) is that plane — normal n (the principal axis, sign-free).
 Otherwise (an edge or corner where a floor meets a wall, a pillar) it is three axis planes, one per axis. Axis planes
 alone would turn a sphere into a staircase that rays leaving it at a grazing angle cross; one mean plane alone would
-put a diagonal wall across every corner. So a cell whose surfaces face along the axes and lie in two or three flat
-axis layers (a floor and the foot of a wall, where the cell holds little of the wall) is axis planes even where its
-normals pass PLANAR: as their mean plane, tilted across the corner, it stopped the light between the floor and the
-wall — a block's face lit the floor at its foot with 0.30 of the exact view factor (tests/gpu/test_lpv_near_field.py).
+put a diagonal wall across every corner. So where the surfaces' positions are known (the cached transport), a cell
+whose surfaces face along the axes and lie in two or three flat axis layers (a floor and the foot of a wall, where
+the cell holds little of the wall) is axis planes even where its normals pass PLANAR: as their mean plane, tilted
+across the corner, it stopped the light between the floor and the wall — a block's face lit the floor at its foot
+with 0.30 of the exact view factor (tests/gpu/test_lpv_near_field.py).
 
 Along each plane direction the cell's surfaces form one layer, at their mean coordinate, or two, at their nearest
 and farthest coordinates, where every surface lies at one or the other and those lie more than LAYER_GAP apart (the
@@ -36,7 +37,7 @@ LAYER_GAP = 0.25  # cells: surfaces of one direction further apart than this alo
 END_CELLS = 0.5  # cells: an end's own crossing, surfaces known only to their voxels
 END_SLACK = 0.05  # cells: an end's own crossing, surfaces where they lie
 FLAT = 0.05  # cells: a layer whose surfaces spread less than this along its axis is a plane
-AXIS_ALIGNED = 1.05  # projected areas / area of surfaces that face along the axes (within 3°: cos + sin ≤ 1.05)
+AXIS_ALIGNED = 1.05  # a cell's projected areas / its area, at most, where its surfaces face along the axes
 FIELDS = ("coverage", "layers", "layers_far")
 # The largest distance to a surface stored in an empty cell (mark_empty_space): a ray skips at most this many
 # cells less one at a time; larger gains little (a room's interior is rarely further from a wall).
@@ -99,9 +100,10 @@ def crossing_layers(area: np.ndarray, normal: np.ndarray, grid: Grid, surfaces: 
 
 
 def _axis_aligned(weights: np.ndarray, cells: _Cells) -> np.ndarray:
-    """Per cell: do its surfaces face along the axes? Their projected areas along the three add up to their area
-    (a surface at θ from an axis: cos θ + sin θ of it, 1.41 at 45°), within AXIS_ALIGNED — not a wall turned off the
-    axes, whose sliver in a cell is flat along x and y alike but is neither."""
+    """Per cell: do its surfaces, taken together, face along the axes? Their projected areas along the three add up
+    to their area, within AXIS_ALIGNED (a surface θ from an axis adds cos θ + sin θ − 1 of its own area: 0.41 at
+    45°). A cell mostly of a wall turned off the axes does not, though its slivers read as flat along x and y alike;
+    a floor with the foot of a turned wall taking a tenth of the cell's area still does."""
     return cells.sum(weights[..., :3].sum(axis=-1)) <= AXIS_ALIGNED * cells.sum(weights[..., 3])
 
 

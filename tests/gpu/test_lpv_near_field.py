@@ -5,43 +5,44 @@ kernel takes as flat octagons), against exact view factors and a closed sphere. 
 deterministic, so the bounds are the measured values with a point or two for other drivers' rounding."""
 import numpy as np
 
-from bounce_gi.gpu_kernels.engine import Engine
 from bounce_gi.gpu_kernels.scene import Material
-from support.stress import settings
+from support.lpv_transfer import irradiance, rendered_transfer
 from support.synthetic import box_quads, quad, quad_scene, rectangle_view_factor
+
+EMITTING = [Material("lit", (0.5,) * 3, emission=(1.0,) * 3), Material("grey", (0.5,) * 3)]
+
+
+def _facing_side(e, stored_normals, facing) -> np.ndarray:
+    """Each receiver's irradiance on the side that faces `facing` (unit, one per receiver): its front where its
+    stored normal (lpv/receivers.py: sign-canonical) points that way, else its back."""
+    front = np.einsum("ij,ij->i", stored_normals, facing) > 0
+    return np.where(front, e[0], e[1])
 
 
 def _block_on_floor_irradiance():
     """A 1 m block standing on an 8 m floor at 32³ (a sunlit box on a ground plane, as a user sets one up): the
     transfer's one-bounce irradiance where every floor cluster sends its area's worth of flux (radiosity B = 1), on
-    the block's −y face, and where the −y face's clusters do, on the floor in front of it; each with its receivers'
-    centroids and the exact view factors (B = 1: irradiance = view factor)."""
+    the outside of the block's −y face, and where the −y face's clusters do, on the floor in front of it; each with
+    the exact view factors (B = 1: irradiance = view factor) and the receivers' distance from the other surface."""
     lo, hi = np.array([0.0, -0.2, 0.0]), np.array([1.0, 0.8, 1.0])
     floor = quad([(-4, -4, 0), (4, -4, 0), (4, 4, 0), (-4, 4, 0)], (0, 0, 1))
-    scene = quad_scene([(floor, 0)] + box_quads(lo, hi, 1, inward=False),
-                       [Material("lit", (0.5,) * 3, emission=(1.0,) * 3), Material("grey", (0.5,) * 3)], [],
-                       (4.0, -4.5, 3.0), (0.5, 0.3, 0.3))
-    engine = Engine()
-    engine.render(scene, settings("lpv", resolution=32, bounces=1))
-    t = engine.pipeline.cache.entries["lpv_transfer"].value[0]
-    engine.shutdown()
+    t = rendered_transfer(quad_scene([(floor, 0)] + box_quads(lo, hi, 1, inward=False), EMITTING, [],
+                                     (4.0, -4.5, 3.0), (0.5, 0.3, 0.3)), 32)
     records, axis, at = t.clusters.records, t.rows[:, 3].astype(int), t.rows[:, 8:11]
     middle = (at[:, 0] > lo[0] + 0.1) & (at[:, 0] < hi[0] - 0.1)  # away from the face's side edges
     face = middle & (axis == 1) & (np.abs(at[:, 1] - lo[1]) < 0.05)
     ground = middle & (axis == 2) & (np.abs(at[:, 2]) < 0.05) & (at[:, 1] < lo[1])
-    out = {}
-    for receivers_, senders, rect, normal in (
-            (face, records["normal"][:, 2] > 0.99, ((-4, -4, 0), (8, 0, 0), (0, 4 + lo[1], 0)), (0, -1, 0)),
+    out = []
+    for receivers_, senders, rect, normal, distance in (
+            (face, records["normal"][:, 2] > 0.99, ((-4, -4, 0), (8, 0, 0), (0, 4 + lo[1], 0)), (0, -1, 0),
+             at[:, 2]),
             (ground, (records["normal"][:, 1] < -0.99) & (np.abs(records["position"][:, 1] - lo[1]) < 0.1),
-             ((lo[0], lo[1], 0), (1, 0, 0), (0, 0, 1)), (0, 0, 1))):
-        flux = np.where(senders, records["normal"][:, 3], 0.0).astype(np.float64)
-        e = np.zeros((2, len(t.areas)))
-        for side in range(2):
-            e[side, t.order[side]] = flux @ t.matrix[side].astype(np.float64)
-        points = at[receivers_]
-        exact = rectangle_view_factor(points, np.tile(normal, (len(points), 1)), *rect, m=200)
-        out[normal[2] == 1] = (e[:, receivers_].max(axis=0), exact, points)
-    return out[False], out[True]
+             ((lo[0], lo[1], 0), (1, 0, 0), (0, 0, 1)), (0, 0, 1), lo[1] - at[:, 1])):
+        e = irradiance(t, np.where(senders, records["normal"][:, 3], 0.0))
+        facing = np.tile(normal, (int(receivers_.sum()), 1)).astype(np.float64)
+        lit = _facing_side(e[:, receivers_], t.rows[receivers_, 4:7], facing)
+        out.append((lit, rectangle_view_factor(at[receivers_], facing, *rect, m=200), distance[receivers_]))
+    return out
 
 
 def test_a_block_on_a_floor_and_the_floor_at_its_foot_light_each_other():
@@ -50,15 +51,13 @@ def test_a_block_on_a_floor_and_the_floor_at_its_foot_light_each_other():
     plane test (lpv/crossings.py), and as their mean plane, tilted 22° across the corner, it stopped the light between
     the two: the floor got 0.30 of its view factor within 0.2 m of the face, 0.70 at 0.2–0.35 m, 0.86 at 0.35–0.6 m,
     0.91 at 0.6–1 m, the face 0.75 at 0.2–0.35 m up (a sunlit box's foot on a ground plane: 0.2–0.5 of Cycles'
-    Diffuse Indirect). As two axis planes: the floor 0.999–1.001 at every distance, the face 0.978–0.989 (its
+    Diffuse Indirect). As two axis planes: the floor 0.999–1.001 at every distance, the face 0.978–0.982 (its
     clusters near the floor are wider than the block's face is, as octagons). Bounds 0.97 and 0.95: the kernel is
-    deterministic; a point and a half for other drivers' rounding, and a plane across the corner costs a quarter."""
-    (face_e, face_exact, face_at), (floor_e, floor_exact, floor_at) = _block_on_floor_irradiance()
-    from_face = -0.2 - floor_at[:, 1]
-    for name, e, exact, where, bound in (("floor", floor_e, floor_exact, from_face, 0.97),
-                                         ("face", face_e, face_exact, face_at[:, 2], 0.95)):
+    deterministic, so about three points for other drivers' rounding; a plane across the corner costs a quarter."""
+    face, floor = _block_on_floor_irradiance()
+    for name, (e, exact, distance), bound in (("floor", floor, 0.97), ("face", face, 0.95)):
         for lo, hi in ((0.0, 0.2), (0.2, 0.35), (0.35, 0.6), (0.6, 1.0)):
-            k = (where >= lo) & (where < hi)
+            k = (distance >= lo) & (distance < hi)
             ratio = e[k].sum() / exact[k].sum()
             print(f"{name} {lo}–{hi} m: {ratio:.3f} of the view factor ({k.sum()} receivers)")
             assert k.sum() >= 4 and bound <= ratio <= 1.02
@@ -78,24 +77,18 @@ def test_a_closed_spheres_inside_does_not_light_its_outside():
     centre = np.array([0.0, 0.0, 1.0])
     sphere = trimesh.creation.icosphere(subdivisions=4, radius=0.8)
     floor = quad([(-4, -4, 0), (4, -4, 0), (4, 4, 0), (-4, 4, 0)], (0, 0, 1))
-    scene = quad_scene([(floor, 0), (sphere.vertices[sphere.faces] + centre, 1)],
-                       [Material("lit", (0.5,) * 3, emission=(1.0,) * 3), Material("grey", (0.5,) * 3)], [],
-                       (4.0, -4.5, 3.0), (0.0, 0.0, 0.8))
-    engine = Engine()
-    engine.render(scene, settings("lpv", resolution=32, bounces=1))
-    t = engine.pipeline.cache.entries["lpv_transfer"].value[0]
-    engine.shutdown()
+    t = rendered_transfer(quad_scene([(floor, 0), (sphere.vertices[sphere.faces] + centre, 1)], EMITTING, [],
+                                     (4.0, -4.5, 3.0), (0.0, 0.0, 0.8)), 32)
     records = t.clusters.records
     at, normal = records["position"][:, :3], records["normal"][:, :3]
-    inside = (np.abs(np.linalg.norm(at - centre, axis=1) - 0.8) < 0.2) & (np.einsum("ij,ij->i", normal, at - centre) < 0)
-    flux = np.where(inside, records["normal"][:, 3], 0.0).astype(np.float64)
-    e = np.zeros((2, len(t.areas)))
-    for side in range(2):
-        e[side, t.order[side]] = flux @ t.matrix[side].astype(np.float64)
-    where, facing, areas = t.rows[:, 8:11], t.rows[:, 4:7], np.asarray(t.areas, np.float64)
+    on_sphere = np.abs(np.linalg.norm(at - centre, axis=1) - 0.8) < 0.2
+    inside = on_sphere & (np.einsum("ij,ij->i", normal, at - centre) < 0)
+    e = irradiance(t, np.where(inside, records["normal"][:, 3], 0.0))
+    where, areas = t.rows[:, 8:11], np.asarray(t.areas, np.float64)
     on = np.abs(np.linalg.norm(where - centre, axis=1) - 0.8) < 0.1
-    out_front = np.einsum("ij,ij->i", facing, where - centre) > 0  # the receiver's front side is the outside
-    outside, within = np.where(out_front, e[0], e[1])[on], np.where(out_front, e[1], e[0])[on]
+    outward = (where[on] - centre) / np.linalg.norm(where[on] - centre, axis=1, keepdims=True)
+    outside = _facing_side(e[:, on], t.rows[on, 4:7], outward)
+    within = _facing_side(e[:, on], t.rows[on, 4:7], -outward)
     cavity = float((within * areas[on]).sum() / areas[on].sum())
     print(f"closed sphere, B = 1 inside: outside at most {outside.max():.4f}, inside {cavity:.3f}")
     assert inside.sum() > 50 and outside.max() <= 0.001 and 0.90 <= cavity <= 1.02

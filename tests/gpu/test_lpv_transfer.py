@@ -206,16 +206,11 @@ def _closed_box_irradiance(degrees: float = 0.0):
     """The transfer's one-bounce irradiance of a closed 2 m box turned `degrees` about z whose every cluster sends its
     area's worth of flux (uniform radiosity B = 1 W/m²), on each receiver's lit side; with the receivers' areas and
     their voxels' distance from the box's nearest edge (LPV cells), and the transfer."""
-    from support.stress import furnace, settings, turned
+    from support.lpv_transfer import irradiance, rendered_transfer
+    from support.stress import furnace, turned
 
-    engine = Engine()
-    engine.render(turned(furnace(1.0, 1.0), degrees), settings("lpv", resolution=16, bounces=1))
-    t = engine.pipeline.cache.entries["lpv_transfer"].value[0]
-    engine.shutdown()
-    flux = t.clusters.records["normal"][:, 3].astype(np.float64)  # each cluster's area
-    e = np.zeros((2, len(t.areas)))
-    for side in range(2):
-        e[side, t.order[side]] = flux @ t.matrix[side].astype(np.float64)
+    t = rendered_transfer(turned(furnace(1.0, 1.0), degrees), 16)
+    e = irradiance(t, t.clusters.records["normal"][:, 3])  # each cluster sends its area's worth
     c, s = np.cos(np.radians(degrees)), np.sin(np.radians(degrees))
     centre = np.asarray(t.clusters.fine.origin) + (t.cells + 0.5) * t.clusters.fine.cell
     unturned = centre @ np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]]).T

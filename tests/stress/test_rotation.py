@@ -8,9 +8,11 @@ measured error of Diffuse Indirect (rel-L1 against the unturned room, and the ra
 bounds, the room at 80 × 60 with each method's default grid (LPV 32³, VCT 64³) — the turned room's walls are what
 users' rooms are.
 Measured 2026-12-05 (the turned room / the unturned one, Diffuse Indirect):
-  LPV: 10° 0.967 (rel-L1 0.035), 30° 0.969 (0.036). Before its transfer's near field took every planar cluster as
-       the octagon it spans in its own plane (lpv/clusters.polygons; an axis plane's rectangle only, before): 10°
-       0.878 (0.122), 30° 0.863 (0.137);
+  LPV: 10° 0.959 (rel-L1 0.042), 30° 0.961 (0.041) since 2026-12-06: the unturned room's floor–wall junction cells
+       became axis planes (lpv/crossings.py) and its light rose 0.8%, the turned room's (whose walls do not face
+       along the axes) did not move; 0.967 (0.035) and 0.969 (0.036) before. Before its transfer's near field took
+       every planar cluster as the octagon it spans in its own plane (lpv/clusters.polygons; an axis plane's
+       rectangle only, before): 10° 0.878 (0.122), 30° 0.863 (0.137);
   VCT: 10° 0.880 (0.120), 30° 0.634 (0.366). Before the VCT's sub-rays read surfaces' depth at both ends of a step
        (vct/crossing.glsl) its per-pixel cones lost up to 29% more of a turned room's light; what is left is mostly
        the bounce gathers (vct/bounce.glsl: 0.84 of the light kept per gathered bounce at 30°, 0.99 unturned).
@@ -28,7 +30,7 @@ from support.stress import box_room, check_sane, rel_l1, turned
 SIZE = (80, 60)
 # (rel-L1 bound, lowest ratio of the means) per method and angle
 BOUNDS = {("none", 30): (0.002, 0.998),
-          ("lpv", 10): (0.055, 0.937), ("lpv", 30): (0.057, 0.939),
+          ("lpv", 10): (0.062, 0.929), ("lpv", 30): (0.061, 0.931),
           ("vct", 10): (0.140, 0.850), ("vct", 30): (0.386, 0.604)}
 _reference = {}
 

@@ -1,0 +1,24 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""The LPV's cached transfer (gpu_kernels/lpv/transfer.py) as the GPU tests read it: made by a render, and the
+one-bounce irradiance it gives when its clusters send a chosen flux."""
+import numpy as np
+
+from bounce_gi.gpu_kernels.engine import Engine
+from support.stress import settings
+
+
+def rendered_transfer(scene, resolution: int):
+    """The Transfer a one-bounce LPV render of `scene` at `resolution`³ caches (the engine shut down after)."""
+    engine = Engine()
+    engine.render(scene, settings("lpv", resolution=resolution, bounces=1))
+    t = engine.pipeline.cache.entries["lpv_transfer"].value[0]
+    engine.shutdown()
+    return t
+
+
+def irradiance(t, flux) -> np.ndarray:
+    """(2, R) float64: each receiver's front and back irradiance (W/m²) when cluster c sends flux[c] W."""
+    e = np.zeros((2, len(t.areas)))
+    for side in range(2):
+        e[side, t.order[side]] = np.asarray(flux, np.float64) @ t.matrix[side].astype(np.float64)
+    return e
