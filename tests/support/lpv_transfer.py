@@ -4,6 +4,7 @@ one-bounce irradiance it gives when its clusters send a chosen flux."""
 import numpy as np
 
 from bounce_gi.gpu_kernels.engine import Engine
+from bounce_gi.gpu_kernels.lpv.transfer import solve
 from support.stress import settings
 
 
@@ -17,8 +18,8 @@ def rendered_transfer(scene, resolution: int):
 
 
 def irradiance(t, flux) -> np.ndarray:
-    """(2, R) float64: each receiver's front and back irradiance (W/m²) when cluster c sends flux[c] W."""
-    e = np.zeros((2, len(t.areas)))
-    for side in range(2):
-        e[side, t.order[side]] = np.asarray(flux, np.float64) @ t.matrix[side].astype(np.float64)
-    return e
+    """(2, R): each receiver's front and back irradiance (W/m²) when cluster c sends flux[c] W, one bounce
+    (transfer.solve with no reflection)."""
+    c = t.clusters.count
+    grey = np.repeat(np.asarray(flux, np.float64)[:, None], 3, axis=1)
+    return solve(t, np.zeros((3, c, c)), grey, 1, 0.0)[0][..., 0].astype(np.float64)
