@@ -30,6 +30,7 @@ from ..gl.bind import ssbo
 from ..scene import Scene, hash_parts
 from .crossings import Surfaces, crossing_layers, volume_fields
 from .occlusion import KEEP_FRONT_BYTES, GeometryVolume, face_blocking, fine_grid, layer_area, side_albedo
+from .wall_sides import clip_to_walls
 
 AXES = 3
 
@@ -136,7 +137,8 @@ def _combined(arrays: list) -> tuple:
 
 def _receivers(arrays: list, fine: Grid) -> dict:
     """Every voxel's receiver per axis, in receiver_order: cells, axis, normals, areas (one layer's at most),
-    positions and the box their surfaces span (m), albedo (2, R, 3)."""
+    positions and the box their surfaces span (m) — of the part in front of a wall that cuts it in its voxel
+    (wall_sides.clip_to_walls) —, the way they face (voxel/resolve.glsl: normal w), albedo (2, R, 3)."""
     parts = []
     for axis, a in enumerate(arrays):
         z, y, x = np.nonzero(a["area"][..., 3] > 0)
@@ -145,11 +147,12 @@ def _receivers(arrays: list, fine: Grid) -> dict:
         world = [np.asarray(fine.origin) + (cells + a[k][z, y, x, :3]) * fine.cell
                  for k in ("position", "extent_lo", "extent_hi")]
         span = (a["extent_hi"][z, y, x, :3] - a["extent_lo"][z, y, x, :3]) * fine.cell
-        parts.append((cells, np.full(len(x), axis), n, layer_area(a["area"][z, y, x, 3], n, fine.cell, span), *world))
-    keys = ("cells", "axis", "normals", "areas", "positions", "lo", "hi")
+        parts.append((cells, np.full(len(x), axis), n, layer_area(a["area"][z, y, x, 3], n, fine.cell, span), *world,
+                      a["normal"][z, y, x, 3]))
+    keys = ("cells", "axis", "normals", "areas", "positions", "lo", "hi", "facing")
     out = {k: np.concatenate([p[i] for p in parts]) for i, k in enumerate(keys)}
     order = receiver_order(out["cells"], out["axis"], fine)
-    out = {k: v[order] for k, v in out.items()}
+    out = clip_to_walls({k: v[order] for k, v in out.items()}, fine.cell)
     out["albedo"] = np.concatenate([side_albedo(a, a_cells) for a, (a_cells, *_) in zip(arrays, parts)],
                                    axis=1)[:, order]
     return out

@@ -117,53 +117,62 @@ from examples import references  # noqa: E402
 # default_principled 0.125 -> 0.120; worse: product_shot 0.100 -> 0.106 (its curved backdrop's clusters as quarter
 # discs), textured 0.065 -> 0.068. The LPV's Glossy Indirect (read from the same light along the reflected direction)
 # moved with them: its bounds rose by 0.005-0.011 in thin_walls, outdoor, product_shot and window_room.
+# 2026-12-06 (stop 43): the LPV rows re-measured after a receiver cut by a one-sided wall in its own voxel (a floor
+# running on under a closed box, the box's bottom with it) is kept on the side the wall faces (lpv/wall_sides.py;
+# tests/gpu/test_lpv_near_field.py: the ground at a building's foot 0.00 -> 0.98 of its view factor). Diffuse
+# Indirect: default_principled 0.120 -> 0.114, many_lights 0.056 -> 0.050, thin_walls 0.054 -> 0.049, outdoor 0.234
+# -> 0.225, metals 0.167 -> 0.164, product_shot 0.106 -> 0.104; worse: window_room 0.068 -> 0.090 (1.02 -> 1.07 of
+# Cycles': a cluster of its sunlit floor had its centre under the low table, whose top hid that light from the room;
+# out from under it, the light of its glossy wood floor, which a VPL sends out diffusely, shows: with that floor
+# made matte in both renderers the room reads 1.03 of Cycles', 0.99 before), cornell_animated 0.045 -> 0.048 (the
+# floor under its blocks reflected as if lit), furnished 0.101 -> 0.104.
 BOUNDS = {
     'default_principled': {
-        'lpv': {'Combined': 0.047, 'Diffuse Direct': 0.008, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.010, 'Glossy Indirect': 0.521, 'Glossy Color': 0.020, 'Diffuse Light': 0.044, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.046, 'Diffuse Direct': 0.008, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.010, 'Glossy Indirect': 0.525, 'Glossy Color': 0.020, 'Diffuse Light': 0.042, 'Diffuse Color match': 0.998},
         'vct': {'Combined': 0.037, 'Diffuse Direct': 0.008, 'Diffuse Indirect': 0.114, 'Diffuse Color': 0.003, 'Glossy Direct': 0.010, 'Glossy Indirect': 0.385, 'Glossy Color': 0.020, 'Diffuse Light': 0.033, 'Diffuse Color match': 0.998},
     },
     'metals': {
-        'lpv': {'Combined': 0.057, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.231, 'Diffuse Color': 0.003, 'Glossy Direct': 0.032, 'Glossy Indirect': 0.628, 'Glossy Color': 0.013, 'Diffuse Light': 0.025, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.057, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.229, 'Diffuse Color': 0.003, 'Glossy Direct': 0.032, 'Glossy Indirect': 0.628, 'Glossy Color': 0.013, 'Diffuse Light': 0.025, 'Diffuse Color match': 0.998},
         'vct': {'Combined': 0.044, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.032, 'Glossy Indirect': 0.536, 'Glossy Color': 0.013, 'Diffuse Light': 0.025, 'Diffuse Color match': 0.998},
     },
     'textured': {
-        'lpv': {'Combined': 0.016, 'Diffuse Direct': 0.002, 'Diffuse Indirect': 0.112, 'Diffuse Color': 0.002, 'Diffuse Light': 0.016, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.015, 'Diffuse Direct': 0.002, 'Diffuse Indirect': 0.111, 'Diffuse Color': 0.002, 'Diffuse Light': 0.015, 'Diffuse Color match': 0.998},
         'vct': {'Combined': 0.020, 'Diffuse Direct': 0.002, 'Diffuse Indirect': 0.139, 'Diffuse Color': 0.002, 'Diffuse Light': 0.019, 'Diffuse Color match': 0.998},
     },
     'window_room': {
-        'lpv': {'Combined': 0.078, 'Diffuse Direct': 0.066, 'Diffuse Indirect': 0.099, 'Diffuse Color': 0.003, 'Glossy Direct': 0.100, 'Glossy Indirect': 0.243, 'Glossy Color': 0.018, 'Diffuse Light': 0.069, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.080, 'Diffuse Direct': 0.066, 'Diffuse Indirect': 0.120, 'Diffuse Color': 0.003, 'Glossy Direct': 0.100, 'Glossy Indirect': 0.265, 'Glossy Color': 0.018, 'Diffuse Light': 0.076, 'Diffuse Color match': 0.998},
         'vct': {'Combined': 0.077, 'Diffuse Direct': 0.066, 'Diffuse Indirect': 0.098, 'Diffuse Color': 0.003, 'Glossy Direct': 0.100, 'Glossy Indirect': 0.201, 'Glossy Color': 0.018, 'Diffuse Light': 0.070, 'Diffuse Color match': 0.998},
     },
     'rug_room': {
-        'lpv': {'Combined': 0.052, 'Diffuse Direct': 0.003, 'Diffuse Indirect': 0.100, 'Diffuse Color': 0.002, 'Glossy Direct': 0.016, 'Glossy Indirect': 0.242, 'Glossy Color': 0.020, 'Diffuse Light': 0.044, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.051, 'Diffuse Direct': 0.003, 'Diffuse Indirect': 0.098, 'Diffuse Color': 0.002, 'Glossy Direct': 0.016, 'Glossy Indirect': 0.240, 'Glossy Color': 0.020, 'Diffuse Light': 0.043, 'Diffuse Color match': 0.998},
         'vct': {'Combined': 0.070, 'Diffuse Direct': 0.003, 'Diffuse Indirect': 0.140, 'Diffuse Color': 0.002, 'Glossy Direct': 0.016, 'Glossy Indirect': 0.261, 'Glossy Color': 0.020, 'Diffuse Light': 0.061, 'Diffuse Color match': 0.998},
     },
     'thin_walls': {
-        'lpv': {'Combined': 0.061, 'Diffuse Direct': 0.096, 'Diffuse Indirect': 0.089, 'Diffuse Color': 0.002, 'Glossy Direct': 0.235, 'Glossy Indirect': 0.349, 'Glossy Color': 0.025, 'Diffuse Light': 0.062, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.060, 'Diffuse Direct': 0.096, 'Diffuse Indirect': 0.084, 'Diffuse Color': 0.002, 'Glossy Direct': 0.235, 'Glossy Indirect': 0.344, 'Glossy Color': 0.025, 'Diffuse Light': 0.062, 'Diffuse Color match': 0.998},
         'vct': {'Combined': 0.071, 'Diffuse Direct': 0.096, 'Diffuse Indirect': 0.075, 'Diffuse Color': 0.002, 'Glossy Direct': 0.235, 'Glossy Indirect': 0.247, 'Glossy Color': 0.025, 'Diffuse Light': 0.072, 'Diffuse Color match': 0.998},
     },
     'lamp_room': {
-        'lpv': {'Combined': 0.080, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.002, 'Glossy Direct': 0.033, 'Glossy Indirect': 0.459, 'Glossy Color': 0.017, 'Emission': 0.002, 'Diffuse Light': 0.121, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.080, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.002, 'Glossy Direct': 0.033, 'Glossy Indirect': 0.461, 'Glossy Color': 0.017, 'Emission': 0.002, 'Diffuse Light': 0.121, 'Diffuse Color match': 0.998},
         'vct': {'Combined': 0.080, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.002, 'Glossy Direct': 0.033, 'Glossy Indirect': 0.384, 'Glossy Color': 0.017, 'Emission': 0.002, 'Diffuse Light': 0.135, 'Diffuse Color match': 0.998},
     },
     'many_lights': {
-        'lpv': {'Combined': 0.065, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.098, 'Diffuse Color': 0.004, 'Glossy Direct': 0.057, 'Glossy Indirect': 0.212, 'Glossy Color': 0.032, 'Diffuse Light': 0.067, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.062, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.093, 'Diffuse Color': 0.004, 'Glossy Direct': 0.057, 'Glossy Indirect': 0.212, 'Glossy Color': 0.032, 'Diffuse Light': 0.064, 'Diffuse Color match': 0.998},
         'vct': {'Combined': 0.080, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.135, 'Diffuse Color': 0.004, 'Glossy Direct': 0.057, 'Glossy Indirect': 0.224, 'Glossy Color': 0.032, 'Diffuse Light': 0.093, 'Diffuse Color match': 0.998},
     },
     'outdoor': {
-        'lpv': {'Combined': 0.048, 'Diffuse Direct': 0.016, 'Diffuse Indirect': 0.269, 'Diffuse Color': 0.003, 'Glossy Direct': 0.048, 'Glossy Indirect': 0.625, 'Glossy Color': 0.033, 'Diffuse Light': 0.027, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.047, 'Diffuse Direct': 0.016, 'Diffuse Indirect': 0.260, 'Diffuse Color': 0.003, 'Glossy Direct': 0.048, 'Glossy Indirect': 0.622, 'Glossy Color': 0.033, 'Diffuse Light': 0.027, 'Diffuse Color match': 0.998},
         'vct': {'Combined': 0.046, 'Diffuse Direct': 0.016, 'Diffuse Indirect': 0.254, 'Diffuse Color': 0.003, 'Glossy Direct': 0.048, 'Glossy Indirect': 0.679, 'Glossy Color': 0.033, 'Diffuse Light': 0.026, 'Diffuse Color match': 0.998},
     },
     'product_shot': {
-        'lpv': {'Combined': 0.041, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.034, 'Glossy Indirect': 0.611, 'Glossy Color': 0.016, 'Diffuse Light': 0.036, 'Diffuse Color match': 0.996},
+        'lpv': {'Combined': 0.041, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.034, 'Glossy Indirect': 0.610, 'Glossy Color': 0.016, 'Diffuse Light': 0.036, 'Diffuse Color match': 0.996},
         'vct': {'Combined': 0.041, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.034, 'Glossy Indirect': 0.486, 'Glossy Color': 0.016, 'Diffuse Light': 0.039, 'Diffuse Color match': 0.996},
     },
     'furnished': {
-        'lpv': {'Combined': 0.079, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.035, 'Glossy Indirect': 0.250, 'Glossy Color': 0.025, 'Emission': 0.009, 'Diffuse Light': 0.084, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.080, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.035, 'Glossy Indirect': 0.252, 'Glossy Color': 0.025, 'Emission': 0.009, 'Diffuse Light': 0.086, 'Diffuse Color match': 0.998},
         'vct': {'Combined': 0.074, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.134, 'Diffuse Color': 0.003, 'Glossy Direct': 0.035, 'Glossy Indirect': 0.232, 'Glossy Color': 0.025, 'Emission': 0.009, 'Diffuse Light': 0.076, 'Diffuse Color match': 0.998},
     },
     'cornell_animated': {
-        'lpv': {'Combined': 0.044, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.089, 'Diffuse Color': 0.002, 'Diffuse Light': 0.043, 'Diffuse Color match': 0.999},
+        'lpv': {'Combined': 0.045, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.092, 'Diffuse Color': 0.002, 'Diffuse Light': 0.045, 'Diffuse Color match': 0.999},
         'vct': {'Combined': 0.059, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.131, 'Diffuse Color': 0.002, 'Diffuse Light': 0.061, 'Diffuse Color match': 0.999},
     },
 }

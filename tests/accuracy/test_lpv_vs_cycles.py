@@ -26,6 +26,9 @@ SCENES = ("cornell", "spot_room", "courtyard")
 # Measured 2026-12-05 against the 4096-spp references (rel-L1 Diffuse Indirect / Combined; noise floor DI / Combined):
 # transfer, 8 bounces: cornell 0.0456 / 0.0273 (0.0114 / 0.0050), spot_room 0.0413 / 0.0161 (0.0127 / 0.0047),
 # courtyard 0.0211 / 0.0191 (0.0202 / 0.0136); Σ ours / Σ Cycles of Diffuse Indirect 0.977 / 0.965 / 1.000.
+# 2026-12-06 (stop 43, a floor under a closed box no longer in the receiver at the box's foot, lpv/wall_sides.py):
+# cornell 0.0493 / 0.0292 (Σ 0.971: that floor had reflected as if lit), spot_room 0.0404 / 0.0157, courtyard
+# 0.0213 / 0.0192; one bounce: cornell 0.0479 / 0.0225, spot_room 0.0501 / 0.0079, courtyard 0.0126 / 0.0142.
 GATHER_FULL = {"cornell": {"diffuse_indirect": 0.070, "combined": 0.039},
                "spot_room": {"diffuse_indirect": 0.068, "combined": 0.027},
                "courtyard": {"diffuse_indirect": 0.063, "combined": 0.048}}

@@ -380,3 +380,20 @@ def test_positions_give_each_voxels_surfaces_centroid_and_box_and_axis_only_keep
             np.testing.assert_allclose(data["extent_lo"][has][:, i], lo, atol=1e-5)
             np.testing.assert_allclose(data["extent_hi"][has][:, i], hi, atol=1e-5)
             np.testing.assert_allclose(data["position"][has][:, i], (lo + hi) / 2, atol=1e-5)
+
+
+def test_positions_keep_which_way_the_surfaces_face(gl):
+    """positions=True: normal w is the area-weighted facing, +1 where every piece faces along the voxel's canonical
+    normal (a floor facing up), −1 where every piece faces the other way (a ceiling facing down: the canonical normal
+    forgets it) and 0 where as much faces each way (a slab's two faces in one voxel) — what lpv/wall_sides.py reads
+    to know which side of a wall is its front. Fixed-point sums: exact to 1e-6."""
+    grid = Grid((0.0, 0.0, 0.0), 1.0, (4, 4, 4))
+    up = quad([(0.5, 0.5, 0.3), (3.5, 0.5, 0.3), (3.5, 3.5, 0.3), (0.5, 3.5, 0.3)])
+    down = quad([(0.5, 0.5, 1.5), (0.5, 3.5, 1.5), (3.5, 3.5, 1.5), (3.5, 0.5, 1.5)])
+    slab = np.concatenate([quad([(0.5, 0.5, 2.2), (3.5, 0.5, 2.2), (3.5, 3.5, 2.2), (0.5, 3.5, 2.2)]),
+                           quad([(0.5, 0.5, 2.8), (0.5, 3.5, 2.8), (3.5, 3.5, 2.8), (3.5, 0.5, 2.8)])])
+    data, _ = run(gl, make_scene(np.concatenate([up, down, slab])), grid, "raster", positions=True, axis_only=2)
+    has = data["area"][..., 3] > 0
+    for layer, facing in ((0, 1.0), (1, -1.0), (2, 0.0)):
+        np.testing.assert_allclose(data["normal"][layer][has[layer]][:, 2], 1.0, atol=1e-6)  # canonical: +z always
+        np.testing.assert_allclose(data["normal"][layer][has[layer]][:, 3], facing, atol=1e-6)

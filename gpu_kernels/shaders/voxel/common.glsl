@@ -10,6 +10,7 @@
 //   acc_area:     A|n.x|, A|n.y|, A|n.z|, A            (unsigned)
 //   acc_albedo:   A·albedo.rgb / u_albedo_max          (unsigned; .w unused)
 //   acc_normal:   A·n.xyz / 2                          (two's complement int in a uint; |Σ A n/2| < 2^31)
+//                 .w with POSITIONS: ±A / 2, + where n is its own canonical normal (the facing, same bound)
 //   acc_emission: A·emission.rgb / u_emission_max      (unsigned; .w unused)
 // With SIDES (voxel/voxelize.py sides=True) the albedo is kept per side of the voxel: acc_albedo holds what the
 // side its canonical normals point to sees (.w: the area seen from there), acc_albedo_back the other side's.
@@ -113,6 +114,11 @@ void deposit_seen(ivec3 v, float area_cells, vec3 n, vec3 albedo, bvec2 seen, ve
     imageAtomicAdd(u_acc_normal, t, uint(int(round(c.x))));
     imageAtomicAdd(u_acc_normal, t + ivec3(1, 0, 0), uint(int(round(c.y))));
     imageAtomicAdd(u_acc_normal, t + ivec3(2, 0, 0), uint(int(round(c.z))));
+#if defined(POSITIONS)
+    // Which way the pieces face, which the canonical normal forgets: a closed box's wall faces out of it, so the
+    // floor it stands on is known to lie on its outer side (lpv/receivers.py clip_to_walls).
+    imageAtomicAdd(u_acc_normal, t + ivec3(3, 0, 0), uint(int(round(dot(c, n) > 0.0 ? 0.5 * a : -0.5 * a))));
+#endif
     if (u_emission_max > 0.0) {
         vec3 e = a * min(max(u_emission, vec3(0.0)) / u_emission_max, vec3(1.0));
         imageAtomicAdd(u_acc_emission, t, fixed_round(e.r));

@@ -8,7 +8,8 @@
 //   with SIDES, albedo rgb is the mean over the pieces seen from the front side only (voxel/common.glsl) and a fifth
 //   volume, albedo_back, the back side's (rgb; a = the same opacity)
 //   with POSITIONS, position rgb = Σ A·(centroid − voxel min corner) / Σ A, in cells, and extent_lo / extent_hi
-//   the box the surfaces span, likewise
+//   the box the surfaces span, likewise; normal w = Σ ±A / Σ A, + for a piece facing along the canonical normal
+//   (1: all face that way, −1: all the other, near 0: both, as a slab's two faces)
 // Pure integer→float arithmetic per voxel: deterministic.
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;  // gl/bind.VOLUME_GROUP
 uniform ivec3 u_grid_size;
@@ -69,6 +70,7 @@ void main() {
 #endif
 #if defined(POSITIONS)
     vec4 position = vec4(vec3(fetch(u_acc_position, v).xyz) * inv, 0.0);
+    normal.w = float(int(fetch(u_acc_normal, v).w)) * (2.0 * inv);
     vec4 extent_lo = vec4(1.0 - vec3(fetch(u_acc_position, v + ivec3(0, u_grid_size.y, 0)).xyz) / 65535.0, 0.0);
     vec4 extent_hi = vec4(vec3(fetch(u_acc_position, v + ivec3(0, 2 * u_grid_size.y, 0)).xyz) / 65535.0, 0.0);
 #endif
