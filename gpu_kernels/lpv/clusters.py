@@ -85,12 +85,13 @@ def _absorb_small(piece: np.ndarray, parent: np.ndarray, smallest: int, offset: 
     return np.where((sizes[piece] < smallest) & near, target, piece)
 
 
-def _group(key: np.ndarray, offset: np.ndarray, gap: float, pairs: np.ndarray, smallest: int) -> np.ndarray:
-    """Cluster index of every side: sides of one key (block and side), in one plane — sorted by plane offset, a
-    new plane where it jumps by more than `gap` (a thin wall's two faces, a rug on a floor) — and connected
-    through `pairs` of neighbouring sides (two rooms' floors in one block, cut apart by the partition's voxels).
-    Pieces of fewer than `smallest` sides are no surfaces of their own (_absorb_small). Clusters are numbered by
-    (key, plane offset)."""
+def _group(key: np.ndarray, offset: np.ndarray, gap: float, pairs: np.ndarray, smallest: int) -> tuple:
+    """(cluster index of every side, whether it is of its cluster's core): sides of one key (block and side), in
+    one plane — sorted by plane offset, a new plane where it jumps by more than `gap` (a thin wall's two faces, a
+    rug on a floor) — and connected through `pairs` of neighbouring sides (two rooms' floors in one block, cut apart
+    by the partition's voxels). Pieces of fewer than `smallest` sides are no surfaces of their own (_absorb_small):
+    a detached one (a tree's trunk in a façade's block and plane) joins its plane's largest piece but is not of
+    its core. Clusters are numbered by (key, plane offset)."""
     order = np.lexsort((offset, key))
     k, d = key[order], offset[order]
     new = np.ones(len(order), bool)
@@ -108,11 +109,11 @@ def _group(key: np.ndarray, offset: np.ndarray, gap: float, pairs: np.ndarray, s
         label = label[label]
         if np.array_equal(label, previous):
             break
-    label = _absorb_small(label, plane, smallest)
-    roots = np.unique(label)
+    joined = _absorb_small(label, plane, smallest)
+    roots = np.unique(joined)
     rank = np.empty(len(roots), np.int64)
     rank[np.lexsort((offset[roots], key[roots]))] = np.arange(len(roots))
-    return rank[np.searchsorted(roots, label)]
+    return rank[np.searchsorted(roots, joined)], joined == label
 
 
 def partitioned(cells: np.ndarray, normals: np.ndarray, positions: np.ndarray, pairs: np.ndarray,
@@ -164,8 +165,9 @@ def make_clusters(cells: np.ndarray, normals: np.ndarray, areas: np.ndarray, fin
     where their surfaces lie and `bounds` the boxes they span, else the voxels' centres and boxes) into at most
     `budget` clusters: the smallest block side S (from 2) whose blocks × sides × planes fit, or S = `block` (an
     update after an edit keeps the blocks it had, so clusters away from the edit stay the same). A cluster's VPL
-    record sits at its sides' area-weighted position; its box spans its voxels' centres and its extent their
-    surfaces. Sides facing nothing (`faces_something`) get none."""
+    record sits at its core sides' area-weighted position, facing their mean normal, with the area of all its sides
+    (_group: a detached bit joined to it is not of its core), and its octagon spans its core's surfaces; its box
+    spans all its voxels' centres. Sides facing nothing (`faces_something`) get none."""
     lengths = np.linalg.norm(normals, axis=1)
     valid = (areas > 0) & (lengths > 0)
     unit = normals / np.maximum(lengths, 1e-30)[:, None]
@@ -183,7 +185,7 @@ def make_clusters(cells: np.ndarray, normals: np.ndarray, areas: np.ndarray, fin
     fixed, block = block is not None, block or 2
     while True:
         key = block_keys(pos[use], side_n[use], fine, block)
-        index = _group(key, offset, 0.5 * fine.cell, pairs, max(2, block * block // 8))
+        index, core = _group(key, offset, 0.5 * fine.cell, pairs, max(2, block * block // 8))
         count = int(index.max()) + 1 if len(index) else 0
         if fixed or count <= budget or block >= max(fine.size):
             break
@@ -192,11 +194,11 @@ def make_clusters(cells: np.ndarray, normals: np.ndarray, areas: np.ndarray, fin
     sides[use] = index
     area = np.repeat(areas, 2)[use].astype(np.float64)
     records = np.zeros(count, VPL_DTYPE)
-    total = np.bincount(index, area, count)
-    for i in range(3):
-        records["position"][:, i] = np.bincount(index, area * pos[use, i], count) / np.maximum(total, 1e-30)
-        records["normal"][:, i] = np.bincount(index, area * side_n[use, i], count)
-    n = records["normal"][:, :3] / np.maximum(total, 1e-30)[:, None]  # the mean side normal: length 1 if planar
+    total, shape = np.bincount(index, area, count), np.bincount(index, area * core, count)
+    for i in range(3):  # where it lies and faces: its core's (a detached bit of it would pull it off its plane)
+        records["position"][:, i] = np.bincount(index, area * core * pos[use, i], count) / np.maximum(shape, 1e-30)
+        records["normal"][:, i] = np.bincount(index, area * core * side_n[use, i], count)
+    n = records["normal"][:, :3] / np.maximum(shape, 1e-30)[:, None]  # the mean side normal: length 1 if planar
     records["normal"][:, :3] = n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-30)
     records["normal"][:, 3] = total
     records["position"][:, 3] = 1.0
@@ -210,7 +212,7 @@ def make_clusters(cells: np.ndarray, normals: np.ndarray, areas: np.ndarray, fin
     np.maximum.at(box[:, 1], index, voxel[use])
     side_lo, side_hi = (voxel - 0.5 * fine.cell, voxel + 0.5 * fine.cell) if bounds is None else \
         (np.repeat(np.asarray(b, np.float64), 2, axis=0) for b in bounds)
-    polygon = polygons(records, n, index, side_lo[use], side_hi[use], fine.cell)
+    polygon = polygons(records, n, index[core], side_lo[use][core], side_hi[use][core], fine.cell)
     return Clusters(block, sides.reshape(-1, 2), records, key[first], offsets, box, polygon, fine, lo, hi)
 
 

@@ -126,21 +126,26 @@ from examples import references  # noqa: E402
 # out from under it, the light of its glossy wood floor, which a VPL sends out diffusely, shows: with that floor
 # made matte in both renderers the room reads 1.03 of Cycles', 0.99 before), cornell_animated 0.045 -> 0.048 (the
 # floor under its blocks reflected as if lit), furnished 0.101 -> 0.104.
+# Then a cluster's record and octagon from its core only (lpv/clusters.py _group: a detached bit joined to a
+# cluster, a tree's crown to a façade at a town block's scale, pulled its octagon off the façade's plane and over
+# the gap): Diffuse Indirect outdoor 0.225 -> 0.200 (the façades facing the camera 0.83 -> 0.87 of Cycles'), metals
+# 0.164 -> 0.159, furnished 0.104 -> 0.100, thin_walls 0.049 -> 0.047; worse: default_principled 0.114 -> 0.118,
+# textured 0.066 -> 0.070, product_shot 0.104 -> 0.106.
 BOUNDS = {
     'default_principled': {
-        'lpv': {'Combined': 0.046, 'Diffuse Direct': 0.008, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.010, 'Glossy Indirect': 0.525, 'Glossy Color': 0.020, 'Diffuse Light': 0.042, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.044, 'Diffuse Direct': 0.008, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.010, 'Glossy Indirect': 0.507, 'Glossy Color': 0.020, 'Diffuse Light': 0.043, 'Diffuse Color match': 0.998},
         'vct': {'Combined': 0.037, 'Diffuse Direct': 0.008, 'Diffuse Indirect': 0.114, 'Diffuse Color': 0.003, 'Glossy Direct': 0.010, 'Glossy Indirect': 0.385, 'Glossy Color': 0.020, 'Diffuse Light': 0.033, 'Diffuse Color match': 0.998},
     },
     'metals': {
-        'lpv': {'Combined': 0.057, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.229, 'Diffuse Color': 0.003, 'Glossy Direct': 0.032, 'Glossy Indirect': 0.628, 'Glossy Color': 0.013, 'Diffuse Light': 0.025, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.055, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.223, 'Diffuse Color': 0.003, 'Glossy Direct': 0.032, 'Glossy Indirect': 0.610, 'Glossy Color': 0.013, 'Diffuse Light': 0.025, 'Diffuse Color match': 0.998},
         'vct': {'Combined': 0.044, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.032, 'Glossy Indirect': 0.536, 'Glossy Color': 0.013, 'Diffuse Light': 0.025, 'Diffuse Color match': 0.998},
     },
     'textured': {
-        'lpv': {'Combined': 0.015, 'Diffuse Direct': 0.002, 'Diffuse Indirect': 0.111, 'Diffuse Color': 0.002, 'Diffuse Light': 0.015, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.016, 'Diffuse Direct': 0.002, 'Diffuse Indirect': 0.114, 'Diffuse Color': 0.002, 'Diffuse Light': 0.016, 'Diffuse Color match': 0.998},
         'vct': {'Combined': 0.020, 'Diffuse Direct': 0.002, 'Diffuse Indirect': 0.139, 'Diffuse Color': 0.002, 'Diffuse Light': 0.019, 'Diffuse Color match': 0.998},
     },
     'window_room': {
-        'lpv': {'Combined': 0.080, 'Diffuse Direct': 0.066, 'Diffuse Indirect': 0.120, 'Diffuse Color': 0.003, 'Glossy Direct': 0.100, 'Glossy Indirect': 0.265, 'Glossy Color': 0.018, 'Diffuse Light': 0.076, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.080, 'Diffuse Direct': 0.066, 'Diffuse Indirect': 0.121, 'Diffuse Color': 0.003, 'Glossy Direct': 0.100, 'Glossy Indirect': 0.265, 'Glossy Color': 0.018, 'Diffuse Light': 0.076, 'Diffuse Color match': 0.998},
         'vct': {'Combined': 0.077, 'Diffuse Direct': 0.066, 'Diffuse Indirect': 0.098, 'Diffuse Color': 0.003, 'Glossy Direct': 0.100, 'Glossy Indirect': 0.201, 'Glossy Color': 0.018, 'Diffuse Light': 0.070, 'Diffuse Color match': 0.998},
     },
     'rug_room': {
@@ -148,7 +153,7 @@ BOUNDS = {
         'vct': {'Combined': 0.070, 'Diffuse Direct': 0.003, 'Diffuse Indirect': 0.140, 'Diffuse Color': 0.002, 'Glossy Direct': 0.016, 'Glossy Indirect': 0.261, 'Glossy Color': 0.020, 'Diffuse Light': 0.061, 'Diffuse Color match': 0.998},
     },
     'thin_walls': {
-        'lpv': {'Combined': 0.060, 'Diffuse Direct': 0.096, 'Diffuse Indirect': 0.084, 'Diffuse Color': 0.002, 'Glossy Direct': 0.235, 'Glossy Indirect': 0.344, 'Glossy Color': 0.025, 'Diffuse Light': 0.062, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.059, 'Diffuse Direct': 0.096, 'Diffuse Indirect': 0.082, 'Diffuse Color': 0.002, 'Glossy Direct': 0.235, 'Glossy Indirect': 0.343, 'Glossy Color': 0.025, 'Diffuse Light': 0.061, 'Diffuse Color match': 0.998},
         'vct': {'Combined': 0.071, 'Diffuse Direct': 0.096, 'Diffuse Indirect': 0.075, 'Diffuse Color': 0.002, 'Glossy Direct': 0.235, 'Glossy Indirect': 0.247, 'Glossy Color': 0.025, 'Diffuse Light': 0.072, 'Diffuse Color match': 0.998},
     },
     'lamp_room': {
@@ -160,15 +165,15 @@ BOUNDS = {
         'vct': {'Combined': 0.080, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.135, 'Diffuse Color': 0.004, 'Glossy Direct': 0.057, 'Glossy Indirect': 0.224, 'Glossy Color': 0.032, 'Diffuse Light': 0.093, 'Diffuse Color match': 0.998},
     },
     'outdoor': {
-        'lpv': {'Combined': 0.047, 'Diffuse Direct': 0.016, 'Diffuse Indirect': 0.260, 'Diffuse Color': 0.003, 'Glossy Direct': 0.048, 'Glossy Indirect': 0.622, 'Glossy Color': 0.033, 'Diffuse Light': 0.027, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.048, 'Diffuse Direct': 0.016, 'Diffuse Indirect': 0.236, 'Diffuse Color': 0.003, 'Glossy Direct': 0.048, 'Glossy Indirect': 0.636, 'Glossy Color': 0.033, 'Diffuse Light': 0.025, 'Diffuse Color match': 0.998},
         'vct': {'Combined': 0.046, 'Diffuse Direct': 0.016, 'Diffuse Indirect': 0.254, 'Diffuse Color': 0.003, 'Glossy Direct': 0.048, 'Glossy Indirect': 0.679, 'Glossy Color': 0.033, 'Diffuse Light': 0.026, 'Diffuse Color match': 0.998},
     },
     'product_shot': {
-        'lpv': {'Combined': 0.041, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.034, 'Glossy Indirect': 0.610, 'Glossy Color': 0.016, 'Diffuse Light': 0.036, 'Diffuse Color match': 0.996},
+        'lpv': {'Combined': 0.041, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.034, 'Glossy Indirect': 0.611, 'Glossy Color': 0.016, 'Diffuse Light': 0.036, 'Diffuse Color match': 0.996},
         'vct': {'Combined': 0.041, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.034, 'Glossy Indirect': 0.486, 'Glossy Color': 0.016, 'Diffuse Light': 0.039, 'Diffuse Color match': 0.996},
     },
     'furnished': {
-        'lpv': {'Combined': 0.080, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.035, 'Glossy Indirect': 0.252, 'Glossy Color': 0.025, 'Emission': 0.009, 'Diffuse Light': 0.086, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.079, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.149, 'Diffuse Color': 0.003, 'Glossy Direct': 0.035, 'Glossy Indirect': 0.250, 'Glossy Color': 0.025, 'Emission': 0.009, 'Diffuse Light': 0.084, 'Diffuse Color match': 0.998},
         'vct': {'Combined': 0.074, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.134, 'Diffuse Color': 0.003, 'Glossy Direct': 0.035, 'Glossy Indirect': 0.232, 'Glossy Color': 0.025, 'Emission': 0.009, 'Diffuse Light': 0.076, 'Diffuse Color match': 0.998},
     },
     'cornell_animated': {

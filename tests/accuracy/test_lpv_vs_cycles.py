@@ -29,6 +29,8 @@ SCENES = ("cornell", "spot_room", "courtyard")
 # 2026-12-06 (stop 43, a floor under a closed box no longer in the receiver at the box's foot, lpv/wall_sides.py):
 # cornell 0.0493 / 0.0292 (Σ 0.971: that floor had reflected as if lit), spot_room 0.0404 / 0.0157, courtyard
 # 0.0213 / 0.0192; one bounce: cornell 0.0479 / 0.0225, spot_room 0.0501 / 0.0079, courtyard 0.0126 / 0.0142.
+# Then clusters placed by their core (lpv/clusters.py _group): cornell 0.0489 / 0.0290, spot_room 0.0404 / 0.0158,
+# courtyard 0.0213 / 0.0192.
 GATHER_FULL = {"cornell": {"diffuse_indirect": 0.070, "combined": 0.039},
                "spot_room": {"diffuse_indirect": 0.068, "combined": 0.027},
                "courtyard": {"diffuse_indirect": 0.063, "combined": 0.048}}

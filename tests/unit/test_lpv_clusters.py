@@ -200,3 +200,22 @@ def test_source_chunks_cover_every_source_once_within_the_budget():
     assert chunks == [(0, 2), (2, 3), (3, 4), (4, 5), (5, 9)]
     assert all(counts[a:b].sum() <= 5 or b - a == 1 for a, b in chunks)
     assert source_chunks(np.zeros(4, int), 5) == []
+
+
+def test_a_detached_bit_in_a_walls_block_and_plane_leaves_the_walls_cluster_where_the_wall_is():
+    """A wall (8 × 8 voxels) and, in its block and plane but three voxels above its top, a bit of something else (2
+    voxels: at a town block's scale, a tree's crown beside a façade). Too small to be a cluster of its own, the bit
+    joins the wall's cluster (its flux and area count there), but the cluster's record and the octagon its kernel
+    integrates near it are the wall's (_group's core): with the bit, the octagon spanned the gap to it and the wall's
+    light was spread over both (here to z = 1.3, the centroid at z = 0.424) — at a town block's scale a façade's
+    octagon 24 m wide for its 6 m, 0.7 m in front of it."""
+    wall = _plane(1, 10, (0, 0), (8, 8))  # y index 10: z 0–8, x 0–8
+    bit = _plane(1, 10, (11, 0), (13, 1))  # z 11–13, x 0–1
+    floor = _plane(2, 0, (0, 0), (16, 20))
+    cells, normals, areas = _scene(wall, bit, floor)
+    c = cl.make_clusters(cells, normals, areas, FINE, 0, block=16)
+    j = c.side_cluster[0, 0]  # the wall's first voxel, front (+y) side
+    assert (c.side_cluster[len(wall[0]):len(wall[0]) + 2, 0] == j).all()  # the bit is in the wall's cluster
+    assert c.records["normal"][j, 3] == pytest.approx(0.66)  # with its area
+    assert c.records["position"][j, [0, 2]] == pytest.approx((0.4, 0.4))  # the wall's centroid
+    assert c.polygon[j, :, 2].max() == pytest.approx(0.8, abs=1e-6)  # the wall's top
