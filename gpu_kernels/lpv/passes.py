@@ -96,13 +96,16 @@ def surface_voxels(scene, grids) -> float:
 
 
 def transfer_budget(scene, grids, s) -> int:
-    """Clusters for the cached transport, or 0 where it does not apply or would not fit `transfer_mb` (T holds
-    2 × clusters × surface voxels float32). Not with cascades: a cascade's T would hold its own grid's clusters
-    only, and its receivers miss the light of every surface outside it (a sphere's finest cascade got 0.43 of the
-    coarse one's irradiance); the per-bounce gather draws each cascade's light from the whole scene's VPLs."""
+    """Clusters for the cached transport (LpvSettings: gather_vpls, more within transfer_pairs), or 0 where it does
+    not apply or would not fit `transfer_mb` (T holds 2 × clusters × surface voxels float32). Not with cascades: a
+    cascade's T would hold its own grid's clusters only, and its receivers miss the light of every surface outside
+    it (a sphere's finest cascade got 0.43 of the coarse one's irradiance); the per-bounce gather draws each
+    cascade's light from the whole scene's VPLs."""
     if s.transport != "transfer" or not s.gathers or len(grids) > 1:
         return 0
-    budget = min(s.gather_vpls, int(s.transfer_mb * 2 ** 20 / (8 * max(surface_voxels(scene, grids), 1.0))))
+    voxels = max(surface_voxels(scene, grids), 1.0)
+    wanted = max(s.gather_vpls, min(2 * s.gather_vpls, int(s.transfer_pairs / voxels)))  # see LpvSettings
+    budget = min(wanted, int(s.transfer_mb * 2 ** 20 / (8 * voxels)))
     return budget if budget >= transfer.MIN_CLUSTERS else 0
 
 

@@ -34,10 +34,13 @@ class LpvSettings:
     # `gathers`). `gather_vpls` bounds the VPLs per bounce: RSM texels and surface voxels are clustered to fit.
     # "transfer" is the gather with its sources fixed per geometry and the kernel cached (lpv/transfer.py): an
     # edit of lights, materials or world re-runs no visibility; `transfer_mb` bounds the cache (MiB per cascade),
-    # past which it gathers.
+    # past which it gathers. Its clusters: `gather_vpls`, or up to twice as many where clusters × surface voxels
+    # stay within `transfer_pairs` (the kernel evaluations of a full build: a scene of few surface voxels — an
+    # outdoor block at 32³, a few objects on a floor — gets finer clusters for the time a large room's take).
     transport: str = "transfer"
     gather_vpls: int = 512
     transfer_mb: int = 512
+    transfer_pairs: int = 12_000_000
 
     def __post_init__(self):
         if not 4 <= self.resolution <= 256:
@@ -48,8 +51,8 @@ class LpvSettings:
             raise ValueError(f"lookup must be 'flux' or 'intensity', not {self.lookup!r}")
         if self.transport not in ("transfer", "gather", "propagate"):
             raise ValueError(f"transport must be 'transfer', 'gather' or 'propagate', not {self.transport!r}")
-        if self.transfer_mb < 1:
-            raise ValueError(f"transfer_mb {self.transfer_mb} must be ≥ 1")
+        if self.transfer_mb < 1 or self.transfer_pairs < 0:
+            raise ValueError(f"transfer_mb {self.transfer_mb} must be ≥ 1 and transfer_pairs {self.transfer_pairs} ≥ 0")
         if self.gathered_bounces < 0:
             raise ValueError(f"gathered_bounces {self.gathered_bounces} must be ≥ 0 (0: gather every bounce)")
         if not 16 <= self.gather_vpls <= 65536:

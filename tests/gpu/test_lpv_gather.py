@@ -64,7 +64,8 @@ def test_the_vpl_list_carries_the_injected_flux(engine):
         flux.append(r.info["cascades"][0]["injected_flux"])
         t = \
             _render(engine, scene, bounces=1, gather_vpls=budget).info["cascades"][0]
-        assert t["transport"] == "transfer" and t["clusters"] <= budget and t["escaped_flux"] == 0
+        # up to twice gather_vpls clusters in a scene of few surface voxels (LpvSettings.transfer_pairs)
+        assert t["transport"] == "transfer" and t["clusters"] <= 2 * budget and t["escaped_flux"] == 0
         flux.append(t["injected_flux"])
     print("injected flux, propagate / gather 64 / transfer 64 / gather 512 / transfer 512:", flux)
     assert flux[1:] == pytest.approx([flux[0]] * 4, rel=1e-4)
