@@ -25,9 +25,8 @@ OWN_ALIGN = 0.5  # cos 60°: own_side
 
 @dataclass
 class Clusters:
-    """Geometry-only sources: which cluster each surface voxel's front / back side belongs to, and each cluster's
-    VPL record (area-weighted centroid of its voxels' centres, mean side normal, w = total area). Clusters are
-    numbered in order of (block and side key, plane offset)."""
+    """Geometry-only sources: the cluster of each surface voxel's front / back side, and each cluster's VPL record
+    (its core's centroid and mean side normal, w = total area), in order of (block and side key, plane offset)."""
     block: int  # S: fine voxels per block side
     side_cluster: np.ndarray  # (R, 2) int: cluster of the front / back side, −1 where it emits nowhere
     records: np.ndarray  # (C,) VPL_DTYPE, flux 0
@@ -38,6 +37,7 @@ class Clusters:
     fine: Grid
     lo: np.ndarray  # the surface voxels' centres' bounding box (faces_something)
     hi: np.ndarray
+    detached: bool = False  # detached pieces kept as clusters of their own (_blocks), as an update must again
 
     @property
     def count(self) -> int:
@@ -69,10 +69,13 @@ def faces_something(points: np.ndarray, normals: np.ndarray, lo: np.ndarray, hi:
 
 
 def _absorb_small(piece: np.ndarray, parent: np.ndarray, smallest: int, offset: np.ndarray | None = None,
-                  reach: float = np.inf) -> np.ndarray:
+                  reach: float = np.inf, points: np.ndarray | None = None) -> np.ndarray:
     """Pieces (labels per side) of fewer than `smallest` sides join the largest piece of their `parent` group —
     an edge voxel whose normal leans away from its neighbours' is no surface of its own — if its plane (mean
-    `offset`) lies within `reach` of theirs: a pillar's inner face is not its outer face's, however small."""
+    `offset`) lies within `reach` of theirs: a pillar's inner face is not its outer face's, however small. With
+    `points` (per side), only a piece whose mean point lies within `reach` of the box of the largest piece's points:
+    a detached piece elsewhere in the block (a strip of floor cut off by a wall, a tree's crown beside a façade)
+    stays a surface of its own, where it is."""
     sizes = np.bincount(piece)
     largest = np.full(int(parent.max(initial=-1)) + 1, -1)
     by_size = np.lexsort((sizes[piece], parent))  # per parent, ascending size: the last one written wins
@@ -82,16 +85,23 @@ def _absorb_small(piece: np.ndarray, parent: np.ndarray, smallest: int, offset: 
     if offset is not None:
         mean = np.bincount(piece, offset) / np.maximum(sizes, 1)
         near = np.abs(mean[piece] - mean[target]) <= reach
+    if points is not None:
+        lo, hi, n = np.full((len(sizes), 3), np.inf), np.full((len(sizes), 3), -np.inf), np.maximum(sizes, 1)
+        np.minimum.at(lo, piece, points), np.maximum.at(hi, piece, points)
+        at = np.stack([np.bincount(piece, points[:, i], len(sizes)) / n for i in range(3)], 1)[piece]
+        near = np.all((at >= lo[target] - reach) & (at <= hi[target] + reach), axis=1)
     return np.where((sizes[piece] < smallest) & near, target, piece)
 
 
-def _group(key: np.ndarray, offset: np.ndarray, gap: float, pairs: np.ndarray, smallest: int) -> tuple:
+def _group(key: np.ndarray, offset: np.ndarray, gap: float, pairs: np.ndarray, smallest: int,
+           points: np.ndarray | None) -> tuple:
     """(cluster index of every side, whether it is of its cluster's core): sides of one key (block and side), in
     one plane — sorted by plane offset, a new plane where it jumps by more than `gap` (a thin wall's two faces, a
     rug on a floor) — and connected through `pairs` of neighbouring sides (two rooms' floors in one block, cut apart
     by the partition's voxels). Pieces of fewer than `smallest` sides are no surfaces of their own (_absorb_small):
-    a detached one (a tree's trunk in a façade's block and plane) joins its plane's largest piece but is not of
-    its core. Clusters are numbered by (key, plane offset)."""
+    a detached one (a tree's crown in a façade's block and plane) joins its plane's largest piece but is not of
+    its core — with `points` (per side), only one within that piece's box; one elsewhere stays a cluster of its
+    own. Clusters are numbered by (key, plane offset)."""
     order = np.lexsort((offset, key))
     k, d = key[order], offset[order]
     new = np.ones(len(order), bool)
@@ -109,7 +119,7 @@ def _group(key: np.ndarray, offset: np.ndarray, gap: float, pairs: np.ndarray, s
         label = label[label]
         if np.array_equal(label, previous):
             break
-    joined = _absorb_small(label, plane, smallest)
+    joined = _absorb_small(label, plane, smallest, reach=gap if points is not None else np.inf, points=points)
     roots = np.unique(joined)
     rank = np.empty(len(roots), np.int64)
     rank[np.lexsort((offset[roots], key[roots]))] = np.arange(len(roots))
@@ -160,11 +170,12 @@ def neighbour_pairs(cells: np.ndarray, sides: np.ndarray, size: tuple) -> np.nda
 
 def make_clusters(cells: np.ndarray, normals: np.ndarray, areas: np.ndarray, fine: Grid, budget: int,
                   block: int | None = None, positions: np.ndarray | None = None,
-                  bounds: tuple | None = None) -> Clusters:
+                  bounds: tuple | None = None, detached: bool | None = None) -> Clusters:
     """Cluster the surface voxels' sides (cells (R, 3) xyz, mean normals (R, 3), areas (R,); `positions` (R, 3)
     where their surfaces lie and `bounds` the boxes they span, else the voxels' centres and boxes) into at most
     `budget` clusters: the smallest block side S (from 2) whose blocks × sides × planes fit, or S = `block` (an
-    update after an edit keeps the blocks it had, so clusters away from the edit stay the same). A cluster's VPL
+    update after an edit keeps the blocks it had, and `detached` (_blocks), so clusters away from the edit stay the
+    same). A cluster's VPL
     record sits at its core sides' area-weighted position, facing their mean normal, with the area of all its sides
     (_group: a detached bit joined to it is not of its core), and its octagon spans its core's surfaces; its box
     spans all its voxels' centres. Sides facing nothing (`faces_something`) get none."""
@@ -182,14 +193,9 @@ def make_clusters(cells: np.ndarray, normals: np.ndarray, areas: np.ndarray, fin
     pairs = neighbour_pairs(cells[use // 2], side_of(side_n[use]), fine.size)
     if positions is not None and len(pairs):
         pairs = pairs[~partitioned(cells, unit, np.asarray(positions, np.float64), use[pairs] // 2, fine)]
-    fixed, block = block is not None, block or 2
-    while True:
-        key = block_keys(pos[use], side_n[use], fine, block)
-        index, core = _group(key, offset, 0.5 * fine.cell, pairs, max(2, block * block // 8))
-        count = int(index.max()) + 1 if len(index) else 0
-        if fixed or count <= budget or block >= max(fine.size):
-            break
-        block += 1
+    block, key, index, core, detached = _blocks(pos[use], side_n[use], offset, pairs, voxel[use], fine, budget,
+                                                block, detached)
+    count = int(index.max()) + 1 if len(index) else 0
     sides = np.full(2 * len(cells), -1, np.int64)
     sides[use] = index
     area = np.repeat(areas, 2)[use].astype(np.float64)
@@ -213,7 +219,27 @@ def make_clusters(cells: np.ndarray, normals: np.ndarray, areas: np.ndarray, fin
     side_lo, side_hi = (voxel - 0.5 * fine.cell, voxel + 0.5 * fine.cell) if bounds is None else \
         (np.repeat(np.asarray(b, np.float64), 2, axis=0) for b in bounds)
     polygon = polygons(records, n, index[core], side_lo[use][core], side_hi[use][core], fine.cell)
-    return Clusters(block, sides.reshape(-1, 2), records, key[first], offsets, box, polygon, fine, lo, hi)
+    return Clusters(block, sides.reshape(-1, 2), records, key[first], offsets, box, polygon, fine, lo, hi, detached)
+
+
+def _blocks(pos, side_n, offset, pairs, points, fine: Grid, budget: int, block: int | None, detached: bool | None):
+    """(block side S, keys, cluster index and core per side, detached) for make_clusters: the smallest S whose
+    clusters fit `budget` with detached pieces joined to their plane's largest (_group without points), then at
+    that S those pieces kept as clusters of their own where that still fits (a strip of floor cut off by a wall:
+    joined, its light left from the floor beyond, metres away). An update gives the S and `detached` it had."""
+    fixed, block = block is not None, block or 2
+    while True:
+        key = block_keys(pos, side_n, fine, block)
+        index, core = _group(key, offset, 0.5 * fine.cell, pairs, max(2, block * block // 8), None)
+        if fixed or (int(index.max()) + 1 if len(index) else 0) <= budget or block >= max(fine.size):
+            break
+        block += 1
+    if detached is False:
+        return block, key, index, core, False
+    kept, kept_core = _group(key, offset, 0.5 * fine.cell, pairs, max(2, block * block // 8), points)
+    if detached or (int(kept.max()) + 1 if len(kept) else 0) <= budget:
+        return block, key, kept, kept_core, True
+    return block, key, index, core, False
 
 
 AXIS_PLANE = 0.985  # cos 10°: a cluster whose normal lies this near an axis takes that axis' plane as its frame

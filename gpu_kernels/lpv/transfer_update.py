@@ -29,7 +29,7 @@ def update_transfer(ctx, programs, gv, grid: Grid, occlusion: bool, prior, limit
     """The Transfer after a geometry edit, from `prior` (the one before it); None where the share of pairs to
     evaluate would reach `limit` (build T anew instead)."""
     new = make_clusters(gv.cells, gv.surface_normal, gv.surface_area, gv.fine, 0, block=prior.clusters.block,
-                        positions=gv.positions, bounds=gv.bounds)
+                        positions=gv.positions, bounds=gv.bounds, detached=prior.clusters.detached)
     before, after = prior.rows, receiver_rows(gv)
     old_r = _match_receivers(before, after)
     old_c = _match(_cluster_rows(prior.clusters), _cluster_rows(new))

@@ -136,9 +136,12 @@ from examples import references  # noqa: E402
 # window_room, 512 in the others): Diffuse Indirect outdoor 0.200 -> 0.128 and metals 0.159 -> 0.132 (both targets
 # met now), default_principled 0.118 -> 0.099, textured 0.070 -> 0.050, many_lights 0.050 -> 0.047, thin_walls
 # 0.047 -> 0.045; worse: product_shot 0.106 -> 0.111. Their full frames 0.9-1.4 s -> 1.2-1.7 s on llvmpipe.
+# Then a detached piece outside the box of its plane's largest piece kept as a cluster of its own where the clusters
+# still fit (lpv/clusters.py _blocks: a strip of ground cut off by a façade had joined the ground beyond the
+# building's corner): thin_walls 0.045 -> 0.043, outdoor 0.128 -> 0.125, product_shot 0.111 -> 0.109.
 BOUNDS = {
     'default_principled': {
-        'lpv': {'Combined': 0.038, 'Diffuse Direct': 0.008, 'Diffuse Indirect': 0.141, 'Diffuse Color': 0.003, 'Glossy Direct': 0.010, 'Glossy Indirect': 0.515, 'Glossy Color': 0.020, 'Diffuse Light': 0.038, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.038, 'Diffuse Direct': 0.008, 'Diffuse Indirect': 0.140, 'Diffuse Color': 0.003, 'Glossy Direct': 0.010, 'Glossy Indirect': 0.514, 'Glossy Color': 0.020, 'Diffuse Light': 0.038, 'Diffuse Color match': 0.998},
         'vct': {'Combined': 0.037, 'Diffuse Direct': 0.008, 'Diffuse Indirect': 0.114, 'Diffuse Color': 0.003, 'Glossy Direct': 0.010, 'Glossy Indirect': 0.385, 'Glossy Color': 0.020, 'Diffuse Light': 0.033, 'Diffuse Color match': 0.998},
     },
     'metals': {
@@ -150,7 +153,7 @@ BOUNDS = {
         'vct': {'Combined': 0.020, 'Diffuse Direct': 0.002, 'Diffuse Indirect': 0.139, 'Diffuse Color': 0.002, 'Diffuse Light': 0.019, 'Diffuse Color match': 0.998},
     },
     'window_room': {
-        'lpv': {'Combined': 0.080, 'Diffuse Direct': 0.066, 'Diffuse Indirect': 0.121, 'Diffuse Color': 0.003, 'Glossy Direct': 0.100, 'Glossy Indirect': 0.265, 'Glossy Color': 0.018, 'Diffuse Light': 0.076, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.080, 'Diffuse Direct': 0.066, 'Diffuse Indirect': 0.120, 'Diffuse Color': 0.003, 'Glossy Direct': 0.100, 'Glossy Indirect': 0.265, 'Glossy Color': 0.018, 'Diffuse Light': 0.075, 'Diffuse Color match': 0.998},
         'vct': {'Combined': 0.077, 'Diffuse Direct': 0.066, 'Diffuse Indirect': 0.098, 'Diffuse Color': 0.003, 'Glossy Direct': 0.100, 'Glossy Indirect': 0.201, 'Glossy Color': 0.018, 'Diffuse Light': 0.070, 'Diffuse Color match': 0.998},
     },
     'rug_room': {
@@ -158,7 +161,7 @@ BOUNDS = {
         'vct': {'Combined': 0.070, 'Diffuse Direct': 0.003, 'Diffuse Indirect': 0.140, 'Diffuse Color': 0.002, 'Glossy Direct': 0.016, 'Glossy Indirect': 0.261, 'Glossy Color': 0.020, 'Diffuse Light': 0.061, 'Diffuse Color match': 0.998},
     },
     'thin_walls': {
-        'lpv': {'Combined': 0.059, 'Diffuse Direct': 0.096, 'Diffuse Indirect': 0.080, 'Diffuse Color': 0.002, 'Glossy Direct': 0.235, 'Glossy Indirect': 0.343, 'Glossy Color': 0.025, 'Diffuse Light': 0.059, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.058, 'Diffuse Direct': 0.096, 'Diffuse Indirect': 0.078, 'Diffuse Color': 0.002, 'Glossy Direct': 0.235, 'Glossy Indirect': 0.343, 'Glossy Color': 0.025, 'Diffuse Light': 0.058, 'Diffuse Color match': 0.998},
         'vct': {'Combined': 0.071, 'Diffuse Direct': 0.096, 'Diffuse Indirect': 0.075, 'Diffuse Color': 0.002, 'Glossy Direct': 0.235, 'Glossy Indirect': 0.247, 'Glossy Color': 0.025, 'Diffuse Light': 0.072, 'Diffuse Color match': 0.998},
     },
     'lamp_room': {
@@ -170,11 +173,11 @@ BOUNDS = {
         'vct': {'Combined': 0.080, 'Diffuse Direct': 0.011, 'Diffuse Indirect': 0.135, 'Diffuse Color': 0.004, 'Glossy Direct': 0.057, 'Glossy Indirect': 0.224, 'Glossy Color': 0.032, 'Diffuse Light': 0.093, 'Diffuse Color match': 0.998},
     },
     'outdoor': {
-        'lpv': {'Combined': 0.039, 'Diffuse Direct': 0.016, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.048, 'Glossy Indirect': 0.613, 'Glossy Color': 0.033, 'Diffuse Light': 0.020, 'Diffuse Color match': 0.998},
+        'lpv': {'Combined': 0.039, 'Diffuse Direct': 0.016, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.048, 'Glossy Indirect': 0.612, 'Glossy Color': 0.033, 'Diffuse Light': 0.020, 'Diffuse Color match': 0.998},
         'vct': {'Combined': 0.046, 'Diffuse Direct': 0.016, 'Diffuse Indirect': 0.254, 'Diffuse Color': 0.003, 'Glossy Direct': 0.048, 'Glossy Indirect': 0.679, 'Glossy Color': 0.033, 'Diffuse Light': 0.026, 'Diffuse Color match': 0.998},
     },
     'product_shot': {
-        'lpv': {'Combined': 0.041, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.034, 'Glossy Indirect': 0.622, 'Glossy Color': 0.016, 'Diffuse Light': 0.036, 'Diffuse Color match': 0.996},
+        'lpv': {'Combined': 0.041, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.034, 'Glossy Indirect': 0.621, 'Glossy Color': 0.016, 'Diffuse Light': 0.036, 'Diffuse Color match': 0.996},
         'vct': {'Combined': 0.041, 'Diffuse Direct': 0.020, 'Diffuse Indirect': 0.150, 'Diffuse Color': 0.003, 'Glossy Direct': 0.034, 'Glossy Indirect': 0.486, 'Glossy Color': 0.016, 'Diffuse Light': 0.039, 'Diffuse Color match': 0.996},
     },
     'furnished': {

@@ -233,3 +233,22 @@ def test_a_scene_of_few_surface_voxels_gets_finer_clusters_for_a_large_rooms_pai
     monkeypatch.setattr(passes, "surface_voxels", lambda scene, grids: float(voxels))
     assert passes.transfer_budget(None, [FINE], LpvSettings()) == clusters
     assert passes.transfer_budget(None, [FINE], LpvSettings(transfer_pairs=0)) == (512 if clusters else 0)
+
+
+def test_a_detached_piece_outside_the_walls_box_keeps_its_own_cluster_where_the_budget_allows():
+    """The wall and the bit above it, clustered to a budget (no block given). Where the clusters fit with it, the
+    bit is a cluster of its own, its record where it is (a strip of ground in front of a façade, cut off by the
+    façade from the ground under the building: joined to that, its light left metres away — an unseen building on a
+    ground plane, Diffuse Indirect 0.166 -> 0.133); where they would not (budget 6 here), it joins the wall's as
+    before. An update after an edit keeps the choice (Clusters.detached) with the block."""
+    cells, normals, areas = _scene(_plane(1, 10, (0, 0), (8, 8)), _plane(1, 10, (11, 0), (13, 1)),
+                                   _plane(2, 0, (0, 0), (16, 20)))
+    own = cl.make_clusters(cells, normals, areas, FINE, 8)
+    wall, bit = own.side_cluster[0, 0], own.side_cluster[64, 0]
+    assert own.detached and own.count <= 8 and wall != bit
+    assert own.records["position"][bit, 2] == pytest.approx(1.2)
+    assert own.records["normal"][bit, 3] == pytest.approx(0.02)
+    joined = cl.make_clusters(cells, normals, areas, FINE, 6)
+    assert not joined.detached and joined.side_cluster[0, 0] == joined.side_cluster[64, 0]
+    again = cl.make_clusters(cells, normals, areas, FINE, 0, block=own.block, detached=own.detached)
+    assert np.array_equal(again.side_cluster, own.side_cluster)
