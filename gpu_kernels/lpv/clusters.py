@@ -175,10 +175,9 @@ def make_clusters(cells: np.ndarray, normals: np.ndarray, areas: np.ndarray, fin
     where their surfaces lie and `bounds` the boxes they span, else the voxels' centres and boxes) into at most
     `budget` clusters: the smallest block side S (from 2) whose blocks × sides × planes fit, or S = `block` (an
     update after an edit keeps the blocks it had, and `detached` (_blocks), so clusters away from the edit stay the
-    same). A cluster's VPL
-    record sits at its core sides' area-weighted position, facing their mean normal, with the area of all its sides
-    (_group: a detached bit joined to it is not of its core), and its octagon spans its core's surfaces; its box
-    spans all its voxels' centres. Sides facing nothing (`faces_something`) get none."""
+    same). A cluster's VPL record sits at its core sides' area-weighted position, facing their mean normal, with the
+    area of all its sides (_group: a detached bit joined to it is not of its core), and its octagon spans its core's
+    surfaces; its box spans all its voxels' centres. Sides facing nothing (`faces_something`) get none."""
     lengths = np.linalg.norm(normals, axis=1)
     valid = (areas > 0) & (lengths > 0)
     unit = normals / np.maximum(lengths, 1e-30)[:, None]

@@ -6,8 +6,8 @@ that goes on under it — a building on a ground plane, a box on a floor, the de
 own bottom face lying on the floor — the voxel at the wall's foot holds floor on both sides of the wall, and its
 receiver's centroid lies on the wall's plane: the wall's clusters light nothing in their own plane (lpv/gather.glsl
 OWN_PLANE), so that receiver got almost none of the wall's light, and the pixels of the floor in front of the wall
-read it. With voxels of 3.4 m (a town block 200 m across at 32³) the ground in front of a sunlit façade got 0.55 of
-Cycles' Diffuse Indirect and the façade's foot 0.54 (its ground was that receiver's light).
+read it. With voxels of 3.4 m (a town block 200 m across at 32³) the ground in front of a sunlit façade got 0.54 of
+Cycles' Diffuse Indirect and the façade's lowest metre 0.53 (its ground was that receiver's light).
 
 The voxelisation knows which way a voxel's surfaces face (voxel/common.glsl: normal w, the facing); a wall whose
 surfaces all face one way has its room, or the open air, in front of it. The floor behind such a wall, within the
