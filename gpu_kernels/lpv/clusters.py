@@ -235,7 +235,8 @@ def _blocks(pos, side_n, offset, pairs, points, fine: Grid, budget: int, block: 
         block += 1
     if detached is False:
         return block, key, index, core, False
-    kept, kept_core = _group(key, offset, 0.5 * fine.cell, pairs, max(2, block * block // 8), points)
+    kept, kept_core = (index, core) if core.all() else \
+        _group(key, offset, 0.5 * fine.cell, pairs, max(2, block * block // 8), points)  # all() then: the same
     if detached or (int(kept.max()) + 1 if len(kept) else 0) <= budget:
         return block, key, kept, kept_core, True
     return block, key, index, core, False

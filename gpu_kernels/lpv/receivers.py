@@ -137,8 +137,8 @@ def _combined(arrays: list) -> tuple:
 
 def _receivers(arrays: list, fine: Grid) -> dict:
     """Every voxel's receiver per axis, in receiver_order: cells, axis, normals, areas (one layer's at most),
-    positions and the box their surfaces span (m) — of the part in front of a wall that cuts it in its voxel
-    (wall_sides.clip_to_walls) —, the way they face (voxel/resolve.glsl: normal w), albedo (2, R, 3)."""
+    positions and the box their surfaces span (m; of the part in front of a wall that cuts it in its voxel:
+    wall_sides.clip_to_walls), the way they face (voxel/resolve.glsl: normal w), albedo (2, R, 3)."""
     parts = []
     for axis, a in enumerate(arrays):
         z, y, x = np.nonzero(a["area"][..., 3] > 0)

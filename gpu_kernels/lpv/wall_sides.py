@@ -35,14 +35,14 @@ FILLED = 0.1  # surfaces covering this much more of the box than lies in front o
 def clip_to_walls(r: dict, cell: float) -> dict:
     """`r` (lpv/receivers._receivers' dict: cells, axis, normals, areas, positions, lo, hi, facing; receivers
     sorted by voxel, then axis) with every receiver cut by a one-sided wall of its own voxel kept in front of the
-    wall: positions, lo, hi and areas replaced (new arrays); `cell`: the fine voxel's size (m)."""
+    wall: positions, lo, hi and areas replaced (new arrays; `r` itself where no wall cuts one); `cell`: the fine
+    voxel's size (m)."""
     cells, normals = r["cells"], r["normals"]
     count = len(cells)
     length = np.linalg.norm(normals, axis=1)
     wall = (np.abs(r["facing"]) >= ONE_SIDED) & (length >= PLANAR)
-    out = {k: np.array(r[k], copy=True) for k in ("positions", "lo", "hi", "areas")}
     if count == 0 or not wall.any():
-        return {**r, **out}
+        return r
     facing_unit = normals / np.maximum(length, 1e-30)[:, None] * np.sign(r["facing"])[:, None]
     same = lambda a, b: np.all(cells[a] == cells[b], axis=1)  # noqa: E731 (receivers a, b share a voxel)
     pairs = []
@@ -63,7 +63,7 @@ def clip_to_walls(r: dict, cell: float) -> dict:
     deep = _behind(r, facing_unit, pairs[:, 1], box, cell, margin).any(axis=1)
     pairs = pairs[deep & ~_behind(r, facing_unit, pairs[:, 1], box, cell, -margin).all(axis=1)]
     if len(pairs) == 0:
-        return {**r, **out}
+        return r
     pairs = pairs[np.argsort(pairs[:, 0], kind="stable")]
     cut, first = np.unique(pairs[:, 0], return_index=True)
     points = _box_samples(r, cut)  # (N, S², 3)
@@ -74,6 +74,7 @@ def clip_to_walls(r: dict, cell: float) -> dict:
     # Only where the surfaces reach behind the wall: more of the box is covered than lies in front of it (a floor
     # cut by a wall at an angle, inside a turned room, covers just the part in front of its wall).
     change = (share >= SLIVER) & (share <= 1.0 - SLIVER) & (fill > share + FILLED)
+    out = {k: np.array(r[k], copy=True) for k in ("positions", "lo", "hi", "areas")}
     i, kept, q = cut[change], ~behind[change], points[change]
     n = kept.sum(axis=1)[:, None]
     out["positions"][i] = (q * kept[..., None]).sum(axis=1) / n

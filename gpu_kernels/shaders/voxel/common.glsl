@@ -116,7 +116,7 @@ void deposit_seen(ivec3 v, float area_cells, vec3 n, vec3 albedo, bvec2 seen, ve
     imageAtomicAdd(u_acc_normal, t + ivec3(2, 0, 0), uint(int(round(c.z))));
 #if defined(POSITIONS)
     // Which way the pieces face, which the canonical normal forgets: a closed box's wall faces out of it, so the
-    // floor it stands on is known to lie on its outer side (lpv/receivers.py clip_to_walls).
+    // floor it stands on is known to lie on its outer side (lpv/wall_sides.py).
     imageAtomicAdd(u_acc_normal, t + ivec3(3, 0, 0), uint(int(round(dot(c, n) > 0.0 ? 0.5 * a : -0.5 * a))));
 #endif
     if (u_emission_max > 0.0) {
