@@ -218,6 +218,12 @@ def albedo_transfer(t: Transfer, weight: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(out.transpose(2, 0, 1), np.float64)
 
 
+def _reflect(m_rho: np.ndarray, phi: np.ndarray) -> np.ndarray:
+    """The sources' flux after one more reflection, (C, 3): M_ρ (3, C, C) per colour channel times φ (C, 3). One
+    matrix-vector product per channel (BLAS), where einsum's loop took four times as long at 1024 clusters."""
+    return np.stack([m_rho[k] @ phi[:, k] for k in range(3)], axis=1)
+
+
 def solve(t: Transfer, m_rho: np.ndarray, first: np.ndarray, bounces: int, epsilon: float,
           gain: np.ndarray | None = None) -> tuple[np.ndarray, list]:
     """Irradiance summed over `bounces` passes, (2, R, 3) per side: T × the sources' flux summed over passes —
@@ -227,14 +233,14 @@ def solve(t: Transfer, m_rho: np.ndarray, first: np.ndarray, bounces: int, epsil
     phi = np.asarray(first, np.float64)
     total = phi.copy()
     passes = [float(phi.sum())]
-    following = np.einsum("kij,jk->ik", m_rho, phi)
+    following = _reflect(m_rho, phi)
     for _ in range(2, bounces + 1):
         phi = following
         passes.append(float(phi.sum()))
         total += phi
         if passes[-1] <= epsilon * max(passes):
             break
-        following = np.einsum("kij,jk->ik", m_rho, phi)
+        following = _reflect(m_rho, phi)
     sums = (total if gain is None else total * gain[:, None]).T.astype(np.float32)  # (3, C)
     out = np.empty((2, t.matrix.shape[2], 3), np.float32)
     for side in range(2):
