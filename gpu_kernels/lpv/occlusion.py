@@ -52,6 +52,8 @@ class GeometryVolume:
     materials_key: str | None = None
     material_signature: list | None = None
     material_weights: dict = field(default_factory=dict)
+    voxels: object = None  # regional.KeptVoxels: the receivers' voxelisation, for an object's move to update
+    voxelised: float = 1.0  # the share of the fine grid voxelised to make it (less after an object's move)
 
     def release(self):
         for t in (self.blocking, self.area, self.normal, self.albedo, self.coverage, self.layers, self.surfaces,

@@ -246,8 +246,9 @@ def _transfer_geometry(frame, grids, k_grids, budget) -> tuple:
     materials = frame.keys["materials"]
     k_gv = (frame.keys["geometry"], k_grids, "geometry only")
 
-    def volumes():
-        gvs = receivers.axis_volumes(ctx, programs, scene, frame.geometry, frame.textures, grids)
+    def volumes():  # after an object's move, the region it changed voxelised into the kept voxelisation
+        prior = cache.prior("geometry_volume", lambda key: key[1:] == k_gv[1:])
+        gvs = receivers.axis_volumes(ctx, programs, scene, frame.geometry, frame.textures, grids, prior, materials)
         signature = receivers.albedo_signature(scene, frame.textures)
         for gv in gvs:  # the materials gv.surface_albedo was made with
             gv.materials_key, gv.material_signature = materials, signature
@@ -304,7 +305,8 @@ def _solve(ctx, programs, gvs, grids, transfers, reflection, sources, s) -> dict
         sides.append(irradiance)
         stats.append({"cells": list(grid.size), "cell": grid.cell, "transport": "transfer",
                       "clusters": t.clusters.count, "block": t.clusters.block, "transfer_mb": t.nbytes / 2 ** 20,
-                      "transfer_updated": t.updated, "injected_flux": float(first.sum()),
+                      "transfer_updated": t.updated, "voxelised": gv.voxelised,
+                      "kept_voxels_mb": gv.voxels.nbytes / 2 ** 20, "injected_flux": float(first.sum()),
                       "escaped_flux": unbinned,
                       "bounces": [{"flux": f} for f in passes], "bounces_used": len(passes)})
     return {"surfaces": receivers.upload_light(ctx, programs, grids, gvs, sides), "stats": stats}

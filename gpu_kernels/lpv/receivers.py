@@ -28,6 +28,7 @@ import numpy as np
 from ..common.grid import Grid
 from ..gl.bind import ssbo
 from ..scene import Scene, hash_parts
+from . import regional
 from .crossings import Surfaces, crossing_layers, volume_fields
 from .occlusion import KEEP_FRONT_BYTES, GeometryVolume, face_blocking, fine_grid, layer_area, side_albedo
 from .wall_sides import clip_to_walls
@@ -35,16 +36,18 @@ from .wall_sides import clip_to_walls
 AXES = 3
 
 
-def _per_axis(ctx, programs, scene: Scene, geometry, textures, fine: Grid, names, front=None, albedo_override=None):
+def _per_axis(ctx, programs, scene: Scene, geometry, textures, fine: Grid, names, front=None, albedo_override=None,
+              region=None):
     """[arrays of axis 0, 1, 2] (VoxelVolumes.read(names)) and the front-most image every pass shared (made by the
-    first pass unless `front` is given; None where the grid keeps one albedo per voxel)."""
+    first pass unless `front` is given; None where the grid keeps one albedo per voxel); of the voxels `region`
+    (lo, hi) only, where given (voxelize)."""
     from ..voxel.voxelize import voxelize
 
     out = []
     for axis in range(AXES):
         vox = voxelize(ctx, programs, scene, geometry, textures, fine, sides=True, front=front,
                        keep_front=front is None, axis_only=axis, positions="position" in names,
-                       albedo_override=albedo_override)
+                       albedo_override=albedo_override, region=region)
         front = front if front is not None else vox.front
         out.append(vox.read(names))
         vox.release()
@@ -85,21 +88,20 @@ def _index_texture(ctx, cells: np.ndarray, axis: np.ndarray, fine: Grid):
     return t
 
 
-def axis_volumes(ctx, programs, scene: Scene, geometry, textures, grids: list) -> list:
+def axis_volumes(ctx, programs, scene: Scene, geometry, textures, grids: list, prior: list | None = None,
+                 materials=None) -> list:
     """Geometry volumes (occlusion.GeometryVolume) whose surface voxels are receivers per dominant axis: the
-    blocking and visibility planes from all surfaces, the receivers' normals, areas and albedo per axis."""
+    blocking and visibility planes from all surfaces, the receivers' normals, areas and albedo per axis.
+    `prior`: geometry volumes of the same grids made before an edit, whose kept voxelisation an object's move
+    updates (lpv/regional.py); `materials`: the pipeline's key of the materials' colours and textures."""
     import moderngl
 
-    from ..voxel.voxelize import front_bytes
-
     out = []
-    for grid in grids:
+    inputs = regional.inputs_key(scene, materials)
+    for k, grid in enumerate(grids):
         fine = fine_grid(grid)
-        arrays, front = _per_axis(ctx, programs, scene, geometry, textures, fine,
-                                  ("area", "normal", "albedo", "albedo_back", "position", "extent_lo", "extent_hi"))
-        if front is not None and front_bytes(fine, 2) > KEEP_FRONT_BYTES:
-            front.release()
-            front = None
+        kept = prior[k].voxels if prior and k < len(prior) else None
+        arrays, front, share = _voxelised(ctx, programs, scene, geometry, textures, fine, kept, inputs)
         area, normal, surfaces = _combined(arrays)
         r = _receivers(arrays, fine)
         blocking = ctx.texture3d(tuple(n + 1 for n in grid.size), 4, face_blocking(area, grid).tobytes(), dtype="f4")
@@ -116,8 +118,32 @@ def axis_volumes(ctx, programs, scene: Scene, geometry, textures, grids: list) -
             receivers=ssbo(ctx, oriented),
             light_volumes=make_light_volumes(ctx, fine, r["cells"], r["axis"]) if dense else None,
             receiver_index=None if dense else _index_texture(ctx, r["cells"], r["axis"], fine),
+            voxels=regional.keep(arrays, scene, inputs), voxelised=share,
             **volume_fields(ctx, crossing_layers(area, normal, grid, surfaces))))
     return out
+
+
+VOXEL_NAMES = ("area", "normal", "albedo", "albedo_back", "position", "extent_lo", "extent_hi")
+
+
+def _voxelised(ctx, programs, scene: Scene, geometry, textures, fine: Grid, kept, inputs) -> tuple:
+    """The three per-axis voxelisations of `fine`, the front-most image to keep (None: none) and the share of the
+    grid voxelised: the whole grid, or after an object's move the region it changed voxelised into a copy of `kept`
+    (lpv/regional.py), whose front-most image is right in the region only and is not kept."""
+    from ..voxel.voxelize import front_bytes
+
+    region = regional.moved_region(kept, scene, fine, inputs)
+    if region is not None:
+        part, front = _per_axis(ctx, programs, scene, geometry, textures, fine, VOXEL_NAMES, region=region)
+        if front is not None:
+            front.release()
+        return regional.paste(kept.arrays(), region, part), None, float(np.prod(region[1] - region[0]) /
+                                                                        np.prod(fine.size))
+    arrays, front = _per_axis(ctx, programs, scene, geometry, textures, fine, VOXEL_NAMES)
+    if front is not None and front_bytes(fine, 2) > KEEP_FRONT_BYTES:
+        front.release()
+        front = None
+    return arrays, front, 1.0
 
 
 def _combined(arrays: list) -> tuple:

@@ -92,7 +92,7 @@ class VoxelVolumes:
 def voxelize(ctx, programs, scene: Scene, geometry, textures, grid: Grid, mode: str = "raster",
              supersample: int = 2, scale_bits: int = DEFAULT_SCALE_BITS, sides: bool = False, front=None,
              keep_front: bool = False, axis_only: int = -1, positions: bool = False,
-             albedo_override: dict | None = None) -> VoxelVolumes:
+             albedo_override: dict | None = None, region: tuple | None = None) -> VoxelVolumes:
     """Voxelise the scene's surfaces into `grid` (GL thread); returns new textures the caller releases.
 
     `geometry`: direct/geometry.GeometryBuffers of `scene` (raster draws its VBO; tessellation uploads its own patch
@@ -110,42 +110,79 @@ def voxelize(ctx, programs, scene: Scene, geometry, textures, grid: Grid, mode: 
     `albedo_override` (raster only), {material index: rgb}: those materials' surfaces get that constant albedo and
     every other surface none — the areas stay, so a one-hot colour gives each voxel side the share of its seen area
     a material covers (lpv/receivers.material_weights).
-    """
+    `region` (raster only), voxels (lo, hi) of `grid`: only those, into volumes of that part (region_grid), each
+    voxel as the whole grid's voxelisation gives it, byte for byte (lpv/regional.py); the rasteriser draws their
+    pixels only (region_scissor). A `front` must then come from the same region or the whole grid."""
     _check_grid(ctx, grid, mode, supersample)
-    if (axis_only >= 0 or positions or albedo_override is not None) and mode != "raster":
-        raise ValueError("axis_only, positions and albedo_override need mode='raster'")
+    if (axis_only >= 0 or positions or albedo_override is not None or region is not None) and mode != "raster":
+        raise ValueError("axis_only, positions, albedo_override and region need mode='raster'")
     supersample = int(supersample)
     albedo_max, emission_max = _maxima(scene, geometry, textures, albedo_override)
     sides = bool(sides) and mode == "raster" and _sides_fit(ctx, grid, supersample)
     positions = bool(positions)
-    accs, flags = _accumulators(ctx, grid, sides, positions)
+    part, scissor, region_uniforms = _region_setup(grid, region, supersample, axis_only)
+    accs, flags = _accumulators(ctx, part, sides, positions)
     patches = patch_buffers(ctx, scene, grid, supersample) if mode == "tessellation" else None
     own_front = sides and front is None
     fronts = ([front] if front is not None else _front_most(ctx, programs, scene, geometry, textures, grid,
-                                                             supersample)) if sides else []
+                                                             supersample, region)) if sides else []
     # image units of voxel/common.glsl: 0–3 accumulators, 4 flags, 5 albedo_back, 6 front-most, 7 positions
     images = list(zip([0, 1, 2, 3] + [5] * sides + [7] * positions + [4] + [6] * len(fronts), accs + [flags] + fronts))
     defines = {**({"SIDES": None} if sides else {}), **({"POSITIONS": None} if positions else {})}
     uniforms = {"u_grid_origin": grid.origin, "u_inv_cell": 1.0 / grid.cell, "u_grid_size": grid.size,
                 "u_supersample": float(supersample), "u_albedo_max": albedo_max, "u_emission_max": emission_max,
-                "u_axis_only": int(axis_only)}
+                "u_axis_only": int(axis_only), **region_uniforms}
     try:
         reruns = 0
         while _deposit(ctx, programs, scene, (geometry, patches), textures, grid, supersample,
                        {**uniforms, "u_fixed_scale": float(2.0 ** scale_bits)}, images, defines,
-                       albedo_override) and scale_bits > 0:
+                       albedo_override, scissor) and scale_bits > 0:
             scale_bits = _smaller_scale(scene, grid, scale_bits, reruns)
             reruns += 1
-        volumes = _resolve(ctx, programs, accs, grid, scale_bits, albedo_max, emission_max, sides, positions)
+        volumes = _resolve(ctx, programs, accs, part, scale_bits, albedo_max, emission_max, sides, positions)
     finally:
         for t in accs + [flags] + (fronts if own_front and not keep_front else []):
             t.release()
         if patches is not None:
             patches[0].release()
-    return VoxelVolumes(grid, *volumes[:4], mode=mode, supersample=supersample, scale_bits=scale_bits,
+    return VoxelVolumes(part, *volumes[:4], mode=mode, supersample=supersample, scale_bits=scale_bits,
                         reruns=reruns, albedo_back=volumes[4] if sides else None,
                         front=fronts[0] if own_front and keep_front else None,
                         **dict(zip(("position", "extent_lo", "extent_hi"), volumes[-3:] if positions else ())))
+
+
+def region_grid(grid: Grid, region: tuple) -> Grid:
+    """The part (lo, hi) of `grid`, voxels lo … hi − 1, as a grid of its own (the volumes of a region's
+    voxelisation)."""
+    lo, hi = (np.asarray(c, np.int64) for c in region)
+    if np.any(lo < 0) or np.any(hi > np.asarray(grid.size)) or np.any(hi <= lo):
+        raise ValueError(f"region {lo.tolist()}..{hi.tolist()} is not a part of grid {grid.size}")
+    return Grid(tuple(np.asarray(grid.origin) + lo * grid.cell), grid.cell, tuple(int(n) for n in hi - lo))
+
+
+def _region_setup(grid: Grid, region, supersample: int, axis_only: int) -> tuple:
+    """The volumes' grid, the raster's scissor and voxel/common.glsl's region uniforms of a voxelisation of `region`
+    (None: the whole grid)."""
+    if region is None:
+        return grid, None, {"u_region_lo": (0, 0, 0), "u_region_size": grid.size}
+    part = region_grid(grid, region)
+    return part, region_scissor(region, supersample, axis_only), {
+        "u_region_lo": tuple(int(c) for c in region[0]), "u_region_size": part.size}
+
+
+# The dominant-axis projection's pixel axes (u, v) per axis (voxel/raster.glsl to_plane: x → (y, z), y → (z, x)).
+PLANE_AXES = ((1, 2), (2, 0), (0, 1))
+
+
+def region_scissor(region: tuple, supersample: int, axis_only: int = -1) -> tuple:
+    """The raster's scissor (x, y, w, h) holding every pixel of the region's voxel columns in the projection along
+    `axis_only` (the union over the three axes for −1): pixels outside it could only deposit outside the region."""
+    lo, hi = (np.asarray(c, np.int64) for c in region)
+    axes = [PLANE_AXES[axis_only]] if axis_only >= 0 else PLANE_AXES
+    u0, v0 = min(lo[u] for u, _ in axes), min(lo[v] for _, v in axes)
+    u1, v1 = max(hi[u] for u, _ in axes), max(hi[v] for _, v in axes)
+    ss = int(supersample)
+    return int(u0 * ss), int(v0 * ss), int((u1 - u0) * ss), int((v1 - v0) * ss)
 
 
 def _maxima(scene, geometry, textures, albedo_override) -> tuple[float, float]:
@@ -171,7 +208,7 @@ def _accumulators(ctx, grid: Grid, sides: bool, positions: bool) -> tuple[list, 
 
 
 def _deposit(ctx, programs, scene, buffers, textures, grid, supersample, uniforms, images, defines,
-             albedo_override=None) -> bool:
+             albedo_override=None, scissor=None) -> bool:
     """One voxelisation pass into the accumulators, zeroed first (`images`: (unit, texture) of voxel/common.glsl,
     the flags at unit 4 and the front-most image, read only, at 6), drawn from `buffers` = (geometry, tessellation
     patches or None); True where a voxel's area sum wrapped."""
@@ -186,7 +223,7 @@ def _deposit(ctx, programs, scene, buffers, textures, grid, supersample, uniform
         t.bind_to_image(unit, read=True, write=True)
     if patches is None:
         _draw_raster(ctx, programs, scene, geometry, textures, grid, supersample, uniforms, defines or None,
-                     albedo_override)
+                     albedo_override, scissor)
     else:
         draw_tessellated(ctx, programs, scene, patches, textures, uniforms)
     ctx.memory_barrier()
@@ -205,9 +242,10 @@ def front_bytes(grid: Grid, supersample: int) -> int:
     return side * side * 2 * int(sum(grid.size)) * 4
 
 
-def _front_most(ctx, programs, scene, geometry, textures, grid, supersample) -> list:
+def _front_most(ctx, programs, scene, geometry, textures, grid, supersample, region=None) -> list:
     """The MODE_FRONT pass of voxel/raster.glsl: an r32ui image of the front-most depth per pixel column, voxel
-    layer and side, the three axes' layers one after the other (a list of it; the caller releases it)."""
+    layer and side, the three axes' layers one after the other (a list of it; the caller releases it). With a
+    `region`, right in the region's columns only."""
     import moderngl
 
     side = int(max(grid.size)) * int(supersample)
@@ -217,7 +255,9 @@ def _front_most(ctx, programs, scene, geometry, textures, grid, supersample) -> 
     front.bind_to_image(6, read=True, write=True)
     uniforms = {"u_grid_origin": grid.origin, "u_inv_cell": 1.0 / grid.cell, "u_grid_size": grid.size,
                 "u_supersample": float(supersample), "u_axis_only": -1}
-    _draw_raster(ctx, programs, scene, geometry, textures, grid, supersample, uniforms, {"MODE_FRONT": None})
+    scissor = None if region is None else region_scissor(region, supersample)
+    _draw_raster(ctx, programs, scene, geometry, textures, grid, supersample, uniforms, {"MODE_FRONT": None},
+                 scissor=scissor)
     ctx.memory_barrier()
     return [front]
 
@@ -271,7 +311,7 @@ def material_maxima(scene: Scene, used, transport: np.ndarray) -> tuple[float, f
 
 
 def _draw_raster(ctx, programs, scene, geometry, textures, grid, supersample, uniforms, defines=None,
-                 albedo_override=None) -> None:
+                 albedo_override=None, scissor=None) -> None:
     import moderngl
 
     prog = programs.raster("voxel/raster.glsl", defines)
@@ -285,6 +325,7 @@ def _draw_raster(ctx, programs, scene, geometry, textures, grid, supersample, un
     try:
         fbo.use()
         fbo.viewport = (0, 0, side, side)
+        ctx.scissor = scissor  # None: every pixel
         ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
         for mat_index, first, count in geometry.ranges:
             bind_material(prog, scene, mat_index, textures)
@@ -292,6 +333,7 @@ def _draw_raster(ctx, programs, scene, geometry, textures, grid, supersample, un
                 _override_albedo(prog, albedo_override.get(mat_index, (0.0, 0.0, 0.0)))
             vao.render(moderngl.TRIANGLES, vertices=count, first=first)
     finally:
+        ctx.scissor = None
         vao.release()
         fbo.release()
 

@@ -44,6 +44,11 @@ layout(binding = 5, r32ui) uniform uimage3D u_acc_albedo_back;
 layout(binding = 7, r32ui) uniform uimage3D u_acc_position;
 #endif
 uniform ivec3 u_grid_size;            // grid size (nx, ny, nz)
+// The accumulators hold the voxels u_region_lo … u_region_lo + u_region_size − 1: all of them (0, u_grid_size), or
+// the part an object's move changed (voxelize's `region`); coordinates stay the whole grid's, so a voxel of the
+// part sums exactly what it sums in a voxelisation of the whole grid.
+uniform ivec3 u_region_lo;
+uniform ivec3 u_region_size;
 
 // Albedo of a voxel surfel: what the surface reflects of the light reaching it, averaged over directions
 // (cosine-weighted), its glossy layers' share included (common/principled.py: transport_albedo): a voxel has no
@@ -67,13 +72,15 @@ uint fixed_round(float x) { return uint(x + 0.5); }   // x ≥ 0; monotone, so c
 // [lo, hi] (cells from the voxel's min corner) to voxel `v`; `seen`: whether its side along canonical_normal(n)
 // (x) and its other side (y) are uncovered (SIDES only: voxel/raster.glsl).
 void deposit_seen(ivec3 v, float area_cells, vec3 n, vec3 albedo, bvec2 seen, vec3 offset, vec3 lo, vec3 hi) {
-    if (any(lessThan(v, ivec3(0))) || any(greaterThanEqual(v, u_grid_size)) || !(area_cells > 0.0)) return;
+    ivec3 r = v - u_region_lo;   // the accumulators' voxel
+    if (any(lessThan(v, ivec3(0))) || any(greaterThanEqual(v, u_grid_size)) || any(lessThan(r, ivec3(0))) ||
+        any(greaterThanEqual(r, u_region_size)) || !(area_cells > 0.0)) return;
     // A piece with positive area counts at least MIN_PIECE_UNITS, so occupancy (area > 0) never loses a voxel a
     // surface really crosses and a voxel holding only slivers still gets a mean albedo/normal to 1/64; the bias
     // is < 64 units (2^-18 cell² at 24 bits) per sliver piece, and none for pieces larger than that.
     float a = max(area_cells * u_fixed_scale, MIN_PIECE_UNITS);
     uint a_fix = fixed_round(a);
-    ivec3 t = ivec3(4 * v.x, v.y, v.z);
+    ivec3 t = ivec3(4 * r.x, r.y, r.z);
     uint before = imageAtomicAdd(u_acc_area, t + ivec3(3, 0, 0), a_fix);
     if (before > 0xFFFFFFFFu - a_fix) imageAtomicOr(u_flags, ivec3(0), 1u);
     vec3 na = abs(n);
@@ -103,7 +110,7 @@ void deposit_seen(ivec3 v, float area_cells, vec3 n, vec3 albedo, bvec2 seen, ve
     vec3 at = a * clamp(offset, vec3(0.0), vec3(1.0));
     uvec3 below = uvec3((1.0 - clamp(lo, vec3(0.0), vec3(1.0))) * 65535.0 + 0.5);
     uvec3 above = uvec3(clamp(hi, vec3(0.0), vec3(1.0)) * 65535.0 + 0.5);
-    ivec3 row = ivec3(0, u_grid_size.y, 0);
+    ivec3 row = ivec3(0, u_region_size.y, 0);
     for (int c = 0; c < 3; ++c) {
         imageAtomicAdd(u_acc_position, t + ivec3(c, 0, 0), fixed_round(at[c]));
         imageAtomicMax(u_acc_position, t + ivec3(c, 0, 0) + row, below[c]);
