@@ -147,17 +147,24 @@ def _voxelised(ctx, programs, scene: Scene, geometry, textures, fine: Grid, kept
 
 
 def _combined(arrays: list) -> tuple:
-    """The three axes' voxelisations as one: area, mean normal and where the surfaces lie (crossings.Surfaces)."""
+    """The three axes' voxelisations as one: area, mean normal and where the surfaces lie (crossings.Surfaces).
+    The means and boxes are taken at the voxels with a surface only (most of a grid is empty)."""
     area = sum(a["area"] for a in arrays)
-    has = [a["area"][..., 3:] > 0 for a in arrays]
-    with np.errstate(invalid="ignore", divide="ignore"):
-        normal = np.nan_to_num(sum(a["area"][..., 3:] * a["normal"] for a in arrays) / area[..., 3:])
-        centroid = np.where(area[..., 3:] > 0, sum(a["area"][..., 3:] * a["position"][..., :3] for a in arrays) /
-                            area[..., 3:], 0.5)
-    own = np.stack([np.where(h[..., 0], a["position"][..., i], np.nan) for i, (a, h) in enumerate(zip(arrays, has))],
+    occupied = np.flatnonzero(area[..., 3] > 0)
+    rows = [{k: a[k].reshape(-1, 4)[occupied] for k in ("area", "normal", "position", "extent_lo", "extent_hi")}
+            for a in arrays]
+    total = area.reshape(-1, 4)[occupied, 3:]
+    normal = np.zeros_like(area)
+    normal.reshape(-1, 4)[occupied] = sum(r["area"][:, 3:] * r["normal"] for r in rows) / total
+    centroid = np.full(area.shape[:3] + (3,), 0.5, np.float32)
+    centroid.reshape(-1, 3)[occupied] = sum(r["area"][:, 3:] * r["position"][:, :3] for r in rows) / total
+    own = np.stack([np.where(a["area"][..., 3] > 0, a["position"][..., i], np.nan) for i, a in enumerate(arrays)],
                    axis=-1)
-    lo = np.stack([np.where(h, a["extent_lo"][..., :3], np.inf) for a, h in zip(arrays, has)]).min(axis=0)
-    hi = np.stack([np.where(h, a["extent_hi"][..., :3], -np.inf) for a, h in zip(arrays, has)]).max(axis=0)
+    lo, hi = (np.full(area.shape[:3] + (3,), fill, np.float32) for fill in (np.inf, -np.inf))
+    lo.reshape(-1, 3)[occupied] = np.stack([np.where(r["area"][:, 3:] > 0, r["extent_lo"][:, :3], np.inf)
+                                            for r in rows]).min(axis=0)
+    hi.reshape(-1, 3)[occupied] = np.stack([np.where(r["area"][:, 3:] > 0, r["extent_hi"][:, :3], -np.inf)
+                                            for r in rows]).max(axis=0)
     return area, normal, Surfaces(centroid, own, lo, hi)
 
 
