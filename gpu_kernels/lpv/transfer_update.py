@@ -50,8 +50,8 @@ def update_transfer(ctx, programs, gv, grid: Grid, occlusion: bool, prior, limit
         old_column[prior.order[side]] = np.arange(len(old_column))
         columns.append(np.empty(len(order[side]), np.int64))
         columns[side][order[side]] = np.arange(len(order[side]))
-        rows = np.take(prior.matrix[side], np.maximum(old_c, 0), axis=0)
-        take_columns(rows, old_column[np.maximum(old_r[order[side]], 0)], matrix[side])
+        take_columns(prior.matrix[side], old_column[np.maximum(old_r[order[side]], 0)], matrix[side],
+                     rows=np.maximum(old_c, 0))
     for first, last in source_chunks(per_source, PAIRS_PER_DISPATCH):  # the pair lists a chunk at a time
         sources, receivers = np.nonzero(fresh[first:last])
         sources += first
@@ -76,18 +76,20 @@ def source_chunks(counts: np.ndarray, most: int) -> list:
     return out
 
 
-def take_columns(src: np.ndarray, columns: np.ndarray, out: np.ndarray) -> None:
-    """out[:, k] = src[:, columns[k]], each run of consecutive columns copied as one slice: an update's columns
-    are the kept clusters' receivers in the order they had, a few hundred runs, where a column-by-column gather
-    (np.take) cost 0.1 s a side in the furnished room."""
+def take_columns(src: np.ndarray, columns: np.ndarray, out: np.ndarray, rows: np.ndarray | None = None) -> None:
+    """out[:, k] = src[rows][:, columns[k]] (`rows`: all of them where None), each run of consecutive columns copied
+    as one block, rows and columns at once: an update's columns are the kept clusters' receivers in the order they
+    had, a few hundred runs, where a column-by-column gather (np.take) cost 0.1 s a side in the furnished room, and
+    gathering the rows first copied T once more."""
     if len(columns) == 0:
         return
     breaks = np.nonzero(np.diff(columns) != 1)[0] + 1
     if len(breaks) > len(columns) // 8:  # short runs: the gather is as fast
-        np.take(src, columns, axis=1, out=out)
+        np.take(src if rows is None else np.take(src, rows, axis=0), columns, axis=1, out=out)
         return
     for a, b in zip(np.concatenate([[0], breaks]), np.concatenate([breaks, [len(columns)]])):
-        out[:, a:b] = src[:, columns[a]:columns[a] + (b - a)]
+        block = slice(columns[a], columns[a] + (b - a))
+        out[:, a:b] = src[:, block] if rows is None else src[rows, block]
 
 
 def box_pairs(ctx, programs, gv, clusters: Clusters, box: np.ndarray) -> np.ndarray:

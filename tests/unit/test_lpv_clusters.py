@@ -195,7 +195,8 @@ def test_the_radius_test_decides_as_the_eigenvalues_do():
 @pytest.mark.parametrize("runs", [True, False])
 def test_take_columns_is_a_column_gather(runs):
     """transfer_update.take_columns copies runs of consecutive columns as slices (or gathers, where runs are short):
-    the same as np.take either way."""
+    the same as np.take either way, and with rows (the kept clusters' old rows, one repeated for a fresh cluster) the
+    same as taking the rows first."""
     from bounce_gi.gpu_kernels.lpv.transfer_update import take_columns
     rng = np.random.default_rng(3)
     src = rng.random((7, 500)).astype(np.float32)
@@ -207,6 +208,10 @@ def test_take_columns_is_a_column_gather(runs):
     out = np.empty((7, len(columns)), np.float32)
     take_columns(src, columns, out)
     assert np.array_equal(out, np.take(src, columns, axis=1))
+    rows = np.array([3, 0, 0, 6, 2, 5, 1, 4])
+    out = np.empty((len(rows), len(columns)), np.float32)
+    take_columns(src, columns, out, rows=rows)
+    assert np.array_equal(out, np.take(np.take(src, rows, axis=0), columns, axis=1))
 
 
 def test_source_chunks_cover_every_source_once_within_the_budget():
