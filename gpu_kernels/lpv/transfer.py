@@ -210,8 +210,9 @@ def bounded_transport(t: Transfer, m_rho: np.ndarray, weight: np.ndarray) -> tup
     rho = per_area.reshape(-1, per_area.shape[-1]).max(axis=0, initial=0.0)
     if all(radius_at_most(m_rho[ch], rho[ch]) for ch in range(m_rho.shape[0])):
         return m_rho, None
-    delivered = sum(t.matrix[side].astype(np.float64) @ areas[t.order[side]]
-                    for side in range(2))
+    # float32 products (BLAS on T as it is): a float64 copy of T cost 60 ms at 500 clusters × 20 000 receivers, for
+    # a cap that float32's sums set to 1e-6
+    delivered = sum(t.matrix[side] @ areas[t.order[side]].astype(np.float32) for side in range(2)).astype(np.float64)
     gain = np.where(delivered > 1.0, 1.0 / np.maximum(delivered, 1e-30), 1.0)
     return m_rho * gain[None, None, :], gain
 
