@@ -190,6 +190,7 @@ def test_the_radius_test_decides_as_the_eigenvalues_do():
         if r == 0.0:
             continue
         assert tr.radius_at_most(m, 1.02 * r) and not tr.radius_at_most(m, 0.98 * r), k
+    assert tr.radius_at_most(np.zeros((0, 0)), 0.5)  # no clusters (an empty scene)
 
 
 @pytest.mark.parametrize("runs", [True, False])
