@@ -95,13 +95,12 @@ def _absorb_small(piece: np.ndarray, parent: np.ndarray, smallest: int, offset: 
 
 def _group(key: np.ndarray, offset: np.ndarray, gap: float, pairs: np.ndarray, smallest: int,
            points: np.ndarray | None) -> tuple:
-    """(cluster index of every side, whether it is of its cluster's core): sides of one key (block and side), in
-    one plane — sorted by plane offset, a new plane where it jumps by more than `gap` (a thin wall's two faces, a
-    rug on a floor) — and connected through `pairs` of neighbouring sides (two rooms' floors in one block, cut apart
-    by the partition's voxels). Pieces of fewer than `smallest` sides are no surfaces of their own (_absorb_small):
-    a detached one (a tree's crown in a façade's block and plane) joins its plane's largest piece but is not of
-    its core — with `points` (per side), only one within that piece's box; one elsewhere stays a cluster of its
-    own. Clusters are numbered by (key, plane offset)."""
+    """(cluster index of every side, whether it is of its cluster's core): sides of one key (block and side), in one
+    plane — sorted by plane offset, a new plane where it jumps by more than `gap` (a thin wall's faces, a rug on a
+    floor) — and connected through `pairs` of neighbouring sides (two rooms' floors cut apart by a partition).
+    Pieces of fewer than `smallest` sides (_absorb_small) join their plane's largest piece but not its core (a tree's
+    crown in a façade's block); with `points` (per side), only within that piece's box, else they stay clusters of
+    their own. Clusters are numbered by (key, plane offset)."""
     order = np.lexsort((offset, key))
     k, d = key[order], offset[order]
     new = np.ones(len(order), bool)
@@ -171,13 +170,12 @@ def neighbour_pairs(cells: np.ndarray, sides: np.ndarray, size: tuple) -> np.nda
 def make_clusters(cells: np.ndarray, normals: np.ndarray, areas: np.ndarray, fine: Grid, budget: int,
                   block: int | None = None, positions: np.ndarray | None = None,
                   bounds: tuple | None = None, detached: bool | None = None) -> Clusters:
-    """Cluster the surface voxels' sides (cells (R, 3) xyz, mean normals (R, 3), areas (R,); `positions` (R, 3)
-    where their surfaces lie and `bounds` the boxes they span, else the voxels' centres and boxes) into at most
-    `budget` clusters: the smallest block side S (from 2) whose blocks × sides × planes fit, or S = `block` (an
-    update after an edit keeps the blocks it had, and `detached` (_blocks), so clusters away from the edit stay the
-    same). A cluster's VPL record sits at its core sides' area-weighted position, facing their mean normal, with the
-    area of all its sides (_group: a detached bit joined to it is not of its core), and its octagon spans its core's
-    surfaces; its box spans all its voxels' centres. Sides facing nothing (`faces_something`) get none."""
+    """Cluster the surface voxels' sides (cells (R, 3) xyz, mean normals (R, 3), areas (R,); `positions` (R, 3) and
+    `bounds` where their surfaces lie and the boxes they span, else the voxels' centres and boxes) into at most
+    `budget` clusters: the smallest block side S (from 2) whose clusters fit, or the S = `block` and `detached` an
+    update had (_blocks), so clusters away from the edit stay the same. A cluster's VPL record: its core sides'
+    area-weighted position and mean normal (_group), the area of all its sides; its octagon spans its core's
+    surfaces, its box all its voxels' centres. Sides facing nothing (`faces_something`) get none."""
     lengths = np.linalg.norm(normals, axis=1)
     valid = (areas > 0) & (lengths > 0)
     unit = normals / np.maximum(lengths, 1e-30)[:, None]
@@ -223,23 +221,25 @@ def make_clusters(cells: np.ndarray, normals: np.ndarray, areas: np.ndarray, fin
 
 def _blocks(pos, side_n, offset, pairs, points, fine: Grid, budget: int, block: int | None, detached: bool | None):
     """(block side S, keys, cluster index and core per side, detached) for make_clusters: the smallest S whose
-    clusters fit `budget` with detached pieces joined to their plane's largest (_group without points), then at
-    that S those pieces kept as clusters of their own where that still fits (a strip of floor cut off by a wall:
-    joined, its light left from the floor beyond, metres away). An update gives the S and `detached` it had."""
-    fixed, block = block is not None, block or 2
+    clusters fit `budget` with detached pieces joined to their plane's largest (_group without points), then those
+    pieces kept as clusters of their own where that still fits (a strip of floor cut off by a wall: joined, its
+    light left from the floor beyond). An update gives the S and `detached` it had."""
+    fixed, block, gap = block is not None, block or 2, 0.5 * fine.cell
     while True:
         key = block_keys(pos, side_n, fine, block)
-        index, core = _group(key, offset, 0.5 * fine.cell, pairs, max(2, block * block // 8), None)
+        if fixed and detached:  # an update of clusters that kept their detached pieces: that grouping alone
+            return (block, key, *_group(key, offset, gap, pairs, max(2, block * block // 8), points), True)
+        index, core = _group(key, offset, gap, pairs, max(2, block * block // 8), None)
         if fixed or (int(index.max()) + 1 if len(index) else 0) <= budget or block >= max(fine.size):
             break
         block += 1
     if detached is False:
         return block, key, index, core, False
-    kept, kept_core = (index, core) if core.all() else \
-        _group(key, offset, 0.5 * fine.cell, pairs, max(2, block * block // 8), points)  # all() then: the same
+    kept, kept_core = (index, core) if core.all() else _group(key, offset, gap, pairs, max(2, block ** 2 // 8), points)
     if detached or (int(kept.max()) + 1 if len(kept) else 0) <= budget:
         return block, key, kept, kept_core, True
     return block, key, index, core, False
+
 
 
 AXIS_PLANE = 0.985  # cos 10°: a cluster whose normal lies this near an axis takes that axis' plane as its frame

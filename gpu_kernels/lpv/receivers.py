@@ -137,8 +137,8 @@ def _voxelised(ctx, programs, scene: Scene, geometry, textures, fine: Grid, kept
         part, front = _per_axis(ctx, programs, scene, geometry, textures, fine, VOXEL_NAMES, region=region)
         if front is not None:
             front.release()
-        return regional.paste(kept.arrays(), region, part), None, float(np.prod(region[1] - region[0]) /
-                                                                        np.prod(fine.size))
+        return regional.paste(kept.arrays(), region, part), None, float(np.prod(region[1] - region[0])) / \
+            fine.voxel_count
     arrays, front = _per_axis(ctx, programs, scene, geometry, textures, fine, VOXEL_NAMES)
     if front is not None and front_bytes(fine, 2) > KEEP_FRONT_BYTES:
         front.release()

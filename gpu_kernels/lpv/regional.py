@@ -73,15 +73,15 @@ def moved_region(kept: KeptVoxels | None, scene: Scene, fine: Grid, inputs: str)
     those the triangles that moved cross, before or after, grown by a voxel (the rasteriser's half-pixel dilation
     and float rounding at the box's faces); None where the whole grid must be: no kept voxelisation, another grid,
     another triangle count or anything but positions changed, nothing moved, or a region over REGION_SHARE."""
-    if kept is None or kept.shape != tuple(reversed(fine.size)) or kept.inputs != inputs:
+    if kept is None or kept.shape != fine.shape_zyx or kept.inputs != inputs:
         return None
     box = moved_box(kept.positions, np.asarray(scene.positions))
     if box is None or box is False:
         return None
     size = np.asarray(fine.size)
-    lo = np.clip(np.floor((box[0] - fine.origin) / fine.cell).astype(np.int64) - 1, 0, size)
-    hi = np.clip(np.floor((box[1] - fine.origin) / fine.cell).astype(np.int64) + 2, 0, size)
-    if np.any(hi <= lo) or np.prod(hi - lo) > REGION_SHARE * np.prod(size):
+    lo = np.clip(fine.voxel_index(box[0]) - 1, 0, size)
+    hi = np.clip(fine.voxel_index(box[1]) + 2, 0, size)
+    if np.any(hi <= lo) or np.prod(hi - lo) > REGION_SHARE * fine.voxel_count:
         return None
     return like_the_grid(lo, hi, size)
 
