@@ -109,30 +109,47 @@ def upload_textures(ctx, scene: Scene) -> MaterialTextures:
 
 def bind_material(prog, scene: Scene, mat_index: int, textures: MaterialTextures) -> None:
     """Set the material uniforms of common/materials.glsl for one material (unused ones are skipped)."""
+    apply_binding(material_binding(prog, scene, mat_index, textures))
+
+
+def material_binding(prog, scene: Scene, mat_index: int, textures: MaterialTextures) -> tuple:
+    """What bind_material sets for one material, resolved once: ([(uniform, value)] of the uniforms `prog` kept,
+    [(texture, unit)] to bind). A pass drawing many views binds each material once per view: resolved, a binding
+    costs a few value writes instead of a lookup per uniform (the sky's 576 RSM views × a room's materials)."""
     mat = scene.materials[mat_index] if 0 <= mat_index < len(scene.materials) else None
-    base = mat.base_color if mat else (0.8, 0.8, 0.8)
-    set_uniform(prog, "u_base_color", tuple(float(c) for c in base[:3]))
-    set_uniform(prog, "u_roughness", float(mat.roughness) if mat else 0.5)
-    set_uniform(prog, "u_material", mat_index if mat else 0)
     scale, offset = textures.transport[mat_index if mat else 0]
-    set_uniform(prog, "u_albedo_scale", tuple(float(c) for c in scale))
-    set_uniform(prog, "u_albedo_offset", tuple(float(c) for c in offset))
-    if "u_material_lut" in prog:
-        textures.lut.use(location=LUT_UNIT)
-        set_uniform(prog, "u_material_lut", LUT_UNIT)
-    set_uniform(prog, "u_emission", tuple(float(c) for c in (mat.emission if mat else (0, 0, 0))[:3]))
     use_tex = bool(mat and 0 <= mat.base_color_texture < len(textures))
-    set_uniform(prog, "u_use_texture", use_tex)
+    values = {"u_base_color": tuple(float(c) for c in (mat.base_color if mat else (0.8, 0.8, 0.8))[:3]),
+              "u_roughness": float(mat.roughness) if mat else 0.5, "u_material": mat_index if mat else 0,
+              "u_albedo_scale": tuple(float(c) for c in scale), "u_albedo_offset": tuple(float(c) for c in offset),
+              "u_material_lut": LUT_UNIT,
+              "u_emission": tuple(float(c) for c in (mat.emission if mat else (0, 0, 0))[:3]),
+              "u_use_texture": use_tex, "u_base_texture": 0}
+    units = [(textures.lut, LUT_UNIT)] if "u_material_lut" in prog else []
     if use_tex:
-        textures[mat.base_color_texture].use(location=0)
-        set_uniform(prog, "u_base_texture", 0)
+        units.append((textures[mat.base_color_texture], 0))
+    else:
+        del values["u_base_texture"]
+    return [(prog[name], value) for name, value in values.items() if name in prog], units
 
 
-def draw_by_material(prog, scene: Scene, geometry: GeometryBuffers, textures: list, vao=None) -> None:
-    """Draw the geometry one material range at a time with that material's uniforms (common/materials.glsl)."""
+def apply_binding(binding: tuple) -> None:
+    """Write a material_binding's uniforms and bind its textures."""
+    uniforms, units = binding
+    for uniform, value in uniforms:
+        uniform.value = value
+    for texture, unit in units:
+        texture.use(location=unit)
+
+
+def draw_by_material(prog, scene: Scene, geometry: GeometryBuffers, textures: list, vao=None,
+                     bindings: dict | None = None) -> None:
+    """Draw the geometry one material range at a time with that material's uniforms (common/materials.glsl).
+    `bindings`: material index → material_binding for `prog`, made once for many draws (made here if None)."""
     import moderngl
 
     vao = vao or geometry.vao_full
     for mat_index, first, count in geometry.ranges:
-        bind_material(prog, scene, mat_index, textures)
+        apply_binding(bindings[mat_index] if bindings is not None else
+                      material_binding(prog, scene, mat_index, textures))
         vao.render(moderngl.TRIANGLES, vertices=count, first=first)

@@ -69,15 +69,17 @@ def rsm_uniforms(prog, rsm, shadows, materials, downsample: int, change: tuple |
     return (rsm.size[0] + downsample - 1) // downsample, (rsm.size[1] + downsample - 1) // downsample
 
 
-def _collect(ctx, slots: int, run) -> np.ndarray:
-    """Run a VPL-writing pass into `slots` zeroed records (binding 6) and keep the ones it wrote (w = 1)."""
+def _collect(ctx, slots: int, run, with_slots: bool = False):
+    """Run a VPL-writing pass into `slots` zeroed records (binding 6) and keep the ones it wrote (w = 1); with
+    `with_slots`, (those records, their slots)."""
     buf = ctx.buffer(reserve=max(slots, 1) * VPL_DTYPE.itemsize)
     buf.clear()
     buf.bind_to_storage_buffer(6)
     run()
     records = np.frombuffer(buf.read(), VPL_DTYPE)
     buf.release()
-    return records[records["position"][:, 3] > 0.5]
+    written = records["position"][:, 3] > 0.5
+    return (records[written], np.nonzero(written)[0]) if with_slots else records[written]
 
 
 def merge(records: np.ndarray, size: float) -> np.ndarray:
@@ -121,38 +123,68 @@ def _fitted(ctx, records: np.ndarray, size: float, block: int, budget: int) -> V
 
 def rsm_records(ctx, programs, rsm, shadows, materials, grid: Grid, budget: int, limit: int | None = None,
                 unit_color: bool = False, lights: np.ndarray | None = None,
-                change: tuple | None = None) -> tuple[np.ndarray, int]:
+                change: tuple | None = None, blocks: np.ndarray | None = None, with_slots: bool = False) -> tuple:
     """The RSM as VPL records (VPL_DTYPE) and k: k×k texel blocks (intensity-aware, lpv/inject.glsl MODE_LIST), k the
     smallest power of two whose blocks number at most `limit` (default a few times `budget`: much of an atlas is
-    empty, a sun's map covers the whole grid, a spot's cone a disc). A block spanning two surfaces gives two VPLs;
-    the grid's cell sets the plane tolerance. Each record's flux.w is its light's index; with `unit_color` its flux
-    is per unit of that light's colour (the flux a colour of 1 would give). `lights` (bool per light): only those
-    lights' texels make records (the same records, in the same order, as without it). `change` (new, old: two
+    empty, a sun's map covers the whole grid, a spot's cone a disc; block_size). A block spanning two surfaces gives
+    two VPLs; the grid's cell sets the plane tolerance. Each record's flux.w is its light's index; with `unit_color`
+    its flux is per unit of that light's colour (the flux a colour of 1 would give). `lights` (bool per light): only
+    those lights' texels make records (the same records, in the same order, as without it). `change` (new, old: two
     arrays of direct/geometry.base_colors rows, old's w = 1 where a material's colour changed): the records' flux is
     what the texels of the changed materials reflect at the new colours less at the old (positions and normals alike:
-    they do not depend on the colours), and only the records with a change are returned."""
-    prog = programs.compute("lpv/inject.glsl", {"MODE_LIST": 1})
+    they do not depend on the colours), and only the records with a change are returned. `blocks` (covered_blocks):
+    only those blocks make records, the same ones the whole atlas gives there. With `with_slots`, (records, k,
+    slots): each record's slot in the whole atlas's list, 2 × (block row × blocks per row + block column) + its
+    plane, the order a run over the whole atlas lists them in (merge_records)."""
+    k = block_size(rsm, PRECLUSTER * budget if limit is None else limit)
+    prog = programs.compute("lpv/inject.glsl", {"MODE_LIST": 1, **({"BLOCK_LIST": 1} if blocks is not None else {})})
     bind_grid(prog, grid)
     set_uniform(prog, "u_unit_color", bool(unit_color))
     set_uniform(prog, "u_masked", lights is not None)
-    mask = ssbo(ctx, np.asarray([] if lights is None else lights, np.uint32))
-    mask.bind_to_storage_buffer(7)
+    buffers = [ssbo(ctx, np.asarray([] if lights is None else lights, np.uint32))]
+    buffers[0].bind_to_storage_buffer(7)
+    if change is not None:
+        buffers += [ssbo(ctx, np.asarray(c, np.float32)) for c in change]
+    size = rsm_uniforms(prog, rsm, shadows, materials, k, tuple(buffers[1:]) if change is not None else None)
+    set_uniform(prog, "u_blocks_x", int(size[0]))
+    if blocks is not None:  # listed: one dispatch, block i's records in slots 2i and 2i + 1
+        rows, columns = np.nonzero(blocks.reshape(size[1], size[0]))
+        buffers.append(ssbo(ctx, np.stack([columns, rows], axis=1).astype(np.int32)))
+        buffers[-1].bind_to_storage_buffer(11)
+        set_uniform(prog, "u_list_count", len(rows))
+        records, index = _collect(ctx, 2 * len(rows), lambda: dispatch(prog, (-(-len(rows) // 64),), local=1),
+                                  with_slots=True)
+        index = 2 * (rows[index // 2] * size[0] + columns[index // 2]) + index % 2
+    else:
+        records, index = _records_in_bands(ctx, prog, rsm, shadows, lights, k, size)
+    for buf in buffers:
+        buf.release()
+    if change is not None:
+        keep = np.any(records["flux"][:, :3] != 0.0, axis=1)
+        records, index = records[keep], index[keep]
+    return (records, k, index) if with_slots else (records, k)
+
+
+def block_size(rsm, limit: int) -> int:
+    """k of rsm_records: the smallest power of two (up to MAX_BLOCK) whose k×k blocks of the atlas number at most
+    `limit` — clustered on the GPU first, so that the read-back stays a few times the budget."""
     k = 1
-    limit = PRECLUSTER * budget if limit is None else limit
     while k < MAX_BLOCK and -(-rsm.size[0] // k) * -(-rsm.size[1] // k) > limit:
-        k *= 2  # cluster on the GPU first, so that the read-back stays a few times the budget
-    buffers = None if change is None else tuple(ssbo(ctx, np.asarray(c, np.float32)) for c in change)
-    blocks = rsm_uniforms(prog, rsm, shadows, materials, k, buffers)
-    set_uniform(prog, "u_blocks_x", int(blocks[0]))
-    boxes = [(0, 0, blocks[0], blocks[1])] if lights is None else [
+        k *= 2
+    return k
+
+
+def _records_in_bands(ctx, prog, rsm, shadows, lights, k: int, size: tuple) -> tuple:
+    """rsm_records over the whole atlas, or (`lights`) the rows of those lights' views: (records, their slots in
+    the whole atlas's list)."""
+    boxes = [(0, 0, size[0], size[1])] if lights is None else [
         (x // k, y // k, -(-w // k), -(-h // k)) for (x, y, w, h), light in zip(rsm.tiles, shadows.buffers.view_lights)
         if lights[light]]
     bands = _bands([(y, y + h) for _, y, _, h in boxes])
-    slots = sum(2 * blocks[0] * (y1 - y0) for y0, y1 in bands)
+    firsts = np.cumsum([0] + [2 * size[0] * (y1 - y0) for y0, y1 in bands])
 
     def run():
-        base = 0
-        for y0, y1 in bands:  # each band of block rows from its own slot on, in the atlas's row order
+        for (y0, y1), base in zip(bands, firsts):  # each band of block rows from its own slot on, in row order
             set_uniform(prog, "u_row_base", int(y0))
             set_uniform(prog, "u_slot_base", int(base))
             for bx, by, bw, bh in boxes:
@@ -160,13 +192,32 @@ def rsm_records(ctx, programs, rsm, shadows, materials, grid: Grid, budget: int,
                     set_uniform(prog, "u_block_origin", (int(bx), int(by)))
                     set_uniform(prog, "u_block_count", (int(bw), int(bh)))
                     dispatch(prog, (bw, bh), local=8)
-            base += 2 * blocks[0] * (y1 - y0)
-    records = _collect(ctx, slots, run)
-    for buf in (mask,) + (buffers or ()):
-        buf.release()
-    if change is not None:
-        records = records[np.any(records["flux"][:, :3] != 0.0, axis=1)]
-    return records, k
+    records, index = _collect(ctx, int(firsts[-1]), run, with_slots=True)
+    # a band's slot s, from slot `base` on for its rows from y0 on, is the whole atlas's s − base + 2·y0·blocks_x
+    band = np.searchsorted(firsts, index, side="right") - 1
+    starts = np.array([y0 for y0, _ in bands] or [0], np.int64)
+    return records, index - firsts[band] + 2 * size[0] * starts[band]
+
+
+def covered_blocks(rects: list, k: int, size: tuple) -> np.ndarray:
+    """(blocks_y × blocks_x,) bool, row-major: the k×k blocks of an atlas of `size` blocks that the texel
+    rectangles `rects` (x, y, w, h) touch."""
+    out = np.zeros((size[1], size[0]), bool)
+    for x, y, w, h in rects:
+        out[y // k:-(-(y + h) // k), x // k:-(-(x + w) // k)] = True
+    return out.ravel()
+
+
+def merge_records(old: tuple, new: tuple, redone: np.ndarray) -> tuple:
+    """(records, slots) of the whole atlas from `old` (records, slots) of it as it was and `new` of only the blocks
+    `redone` marks (covered_blocks; rsm_records with them, after those texels were drawn again): old's records
+    outside those blocks, new's inside, in slot order — what a run over the whole atlas gives, when nothing else
+    changed."""
+    keep = ~redone[old[1] // 2]
+    records = np.concatenate([old[0][keep], new[0]])
+    slots = np.concatenate([old[1][keep], new[1]])
+    order = np.argsort(slots, kind="stable")
+    return records[order], slots[order]
 
 
 def _bands(spans: list) -> list:

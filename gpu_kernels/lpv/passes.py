@@ -144,8 +144,11 @@ def _transfer(frame, grids, k_grids, maps, k_rsm, budget) -> MethodOutput:
     k_src = (k_rsm, keys["transfer"], frame.keys["layers"], frame.keys["materials"])
     prior = cache.prior("lpv_inject", lambda k: k[1:3] == k_src[1:3] and k[0][:2] == k_rsm[:2]
                         and k[0][3:] == k_rsm[3:])
+    # After an object's move (new clusters: no prior), the records of the RSM's texels it left as they were are kept
+    source = (maps, maps.generation, frame.keys["materials"], k_grids)
+    kept = cache.prior("lpv_inject", lambda k: True)
     units = cache.run("lpv_inject", k_src, lambda: first_bounce(
-        ctx, programs, maps, frame.shadows, frame.textures, transfers, grids, budget, prior)).units
+        ctx, programs, maps, frame.shadows, frame.textures, transfers, grids, budget, prior, kept, source)).units
     colours = frame.shadows.buffers.lights["color_type"][:, :3].astype(np.float64)  # (lights, 3)
     k_prop = (k_src, frame.keys["shadow"], keys["albedo_transfer"], keys["gv"], s.max_iterations, s.clamp_negative,
               s.bounces, s.epsilon)
@@ -171,22 +174,31 @@ class FirstBounce:
     # (cascade, material) → that material's texels' first bounce per unit of its base colour (first, lost), for
     # these lights: a later colour edit of the same non-metal is that times the colour's change (recolor).
     bases: dict = field(default_factory=dict)
+    # Per cascade the RSM's records and their slots (gather.rsm_records), and what they were made from: (the RSM
+    # atlas, its generation, the materials' key, the grids' keys). None where the rows were updated per light.
+    records: list = None
+    source: tuple = None
 
 
 MAX_BASES = 4  # materials whose FirstBounce.bases a pipeline keeps (the ones edited last)
 
 
-def first_bounce(ctx, programs, maps, shadows, materials, transfers, grids, budget, prior=None) -> FirstBounce:
+def first_bounce(ctx, programs, maps, shadows, materials, transfers, grids, budget, prior=None, kept=None,
+                 source=None) -> FirstBounce:
     """The RSMs' texels as VPL records (gather.rsm_records) binned per light into the clusters (clusters.bin_flux).
     With `prior` (made with the same RSMs, clusters and material layers), only the lights whose signature changed
     are binned again — a light's move costs that light's texels, not every light's; the others' rows are the
     prior's (a light's records and their order do not depend on the other lights) plus, where materials' colours
-    changed, what the change adds (recolor) — a colour edit costs its material's texels once, then nothing."""
+    changed, what the change adds (recolor) — a colour edit costs its material's texels once, then nothing.
+    Without one, every record is binned, made again only where `kept` allows (texel_records); `source` is what
+    they are made from (FirstBounce.source)."""
     signatures, colors = shadows.light_keys, materials.colors
     if prior is None or len(prior.signatures) != len(signatures) or prior.colors.shape != colors.shape:
-        units = [_bin(ctx, programs, maps, shadows, materials, t, grid, budget, len(signatures))
-                 for t, grid in zip(transfers, grids)]
-        return FirstBounce(units, signatures, colors, len(signatures))
+        records = [texel_records(ctx, programs, maps, shadows, materials, grid, kept, k, source)
+                   for k, grid in enumerate(grids)]
+        units = [clusters.bin_flux(t.clusters, r[0], t.cells, t.normals, groups=len(signatures), axis=t.axis)
+                 for t, r in zip(transfers, records)]
+        return FirstBounce(units, signatures, colors, len(signatures), records=records, source=source)
     redo = np.array([a != b for a, b in zip(signatures, prior.signatures)], bool)
     recolored = np.any(prior.colors != colors, axis=1)
     out = FirstBounce([], signatures, colors, int(redo.sum()), int(recolored.sum()),
@@ -229,6 +241,26 @@ def recolor(first, lost, old, new, lights, bases, cascade, bin_change) -> tuple:
         change = bin_change((new, np.column_stack([old[:, :3], metals])), lights)
         first, lost = first + change[0], lost + change[1]
     return first, lost
+
+
+def texel_records(ctx, programs, maps, shadows, materials, grid, kept, cascade, source) -> tuple:
+    """One cascade's RSM records and their slots (gather.rsm_records). From `kept`, a FirstBounce made from this RSM
+    atlas as it was one update ago, with the same lights, materials and grids (`source`), only the blocks that
+    update drew again are made again (gather.merge_records): an object's move costs the texels it covers in each
+    view, not every light's texels — the same records, in the same order."""
+    args = (ctx, programs, maps, shadows, materials, grid, 0, clusters.TEXEL_RECORDS)
+    reusable = (isinstance(kept, FirstBounce) and kept.records is not None and source is not None
+                and maps.redrawn is not None and kept.source[0] is maps and kept.source[1] + 1 == maps.generation
+                and kept.source[2:] == source[2:] and kept.signatures == shadows.light_keys
+                and np.array_equal(kept.colors, materials.colors))
+    if not reusable:
+        records, _, slots = gather.rsm_records(*args, unit_color=True, with_slots=True)
+        return records, slots
+    k = gather.block_size(maps, clusters.TEXEL_RECORDS)
+    redone = gather.covered_blocks([maps.tiles[i] if rect is None else rect for i, rect in maps.redrawn], k,
+                                   (-(-maps.size[0] // k), -(-maps.size[1] // k)))
+    records, _, slots = gather.rsm_records(*args, unit_color=True, blocks=redone, with_slots=True)
+    return gather.merge_records(kept.records[cascade], (records, slots), redone)
 
 
 def _bin(ctx, programs, maps, shadows, materials, t, grid, budget, groups, lights=None, change=None) -> tuple:

@@ -10,7 +10,7 @@ import numpy as np
 
 from ..common import atlas
 from ..common import lights as lb
-from ..direct.geometry import draw_by_material
+from ..direct.geometry import draw_by_material, material_binding
 from ..direct.shadows import redraw_plan
 from ..gl.bind import set_uniform, ssbo, write_uniform
 from ..scene import Scene
@@ -32,7 +32,12 @@ class Rsm:
     drawn: int = 0  # views drawn (whole or in part) when it was last made or updated
     positions: np.ndarray = None  # the scene's triangles it was drawn from (Scene.positions)
     geometry: object = None  # the GeometryBuffers `vao` draws
-    partial: int = 0  # of the views drawn, those drawn in a rectangle only (an object's move: moved_rect)
+    partial: int = 0  # of the views drawn, those drawn in a rectangle only (an object's move: moved_rects)
+    # Updates drawn into this atlas since it was made, and what the last one drew: (view, rect or None for its
+    # whole tile) per view, None where it was drawn anew — the texels the RSM's records must be made again from
+    # (lpv/passes.texel_records).
+    generation: int = 0
+    redrawn: list = None
 
     def release(self):
         for obj in (self.position, self.normal, self.albedo, self.views_ssbo, self.fbo, self.depth, self.vao):
@@ -92,7 +97,7 @@ def render_rsm(ctx, programs, scene: Scene, geometry, textures, shadows, resolut
     `texel` (m, > 0): the finest texel an orthographic view needs (view_resolution). With `prior` (the RSM of the
     same textures, tiled alike) only what changed is drawn again, into `prior`, which is returned updated, as
     direct/shadows.render_depth does with the depth atlas: the views that changed (a light's move redraws its own),
-    and where the scene's triangles moved, in every other view the rectangle they cover (moved_rect)."""
+    and where the scene's triangles moved, in every other view the rectangle they cover (moved_rects)."""
     import moderngl
 
     buffers = shadows.buffers
@@ -113,6 +118,7 @@ def render_rsm(ctx, programs, scene: Scene, geometry, textures, shadows, resolut
     ctx.enable(moderngl.DEPTH_TEST)
     ctx.disable(moderngl.CULL_FACE)
     prog = programs.raster("lpv/rsm.glsl")
+    bindings = {m: material_binding(prog, scene, m, textures) for m, _, _ in geometry.ranges}
     records = np.zeros(len(views), RSM_VIEW_DTYPE)
     for i, (view, (x, y, w, h)) in enumerate(zip(views, tiles)):
         _view_record(records[i], view, view_lights[i], buffers.lights[view_lights[i]], i, w)
@@ -129,7 +135,7 @@ def render_rsm(ctx, programs, scene: Scene, geometry, textures, shadows, resolut
         set_uniform(prog, "u_ortho", bool(view.ortho))
         set_uniform(prog, "u_far", 0.0 if view.ortho else float(view.far))
         set_uniform(prog, "u_view_index", float(i))
-        draw_by_material(prog, scene, geometry, textures, vao=out.vao)
+        draw_by_material(prog, scene, geometry, textures, vao=out.vao, bindings=bindings)
     ctx.scissor = None
     if out.views_ssbo is not None and out.views_ssbo.size == records.nbytes:
         out.views_ssbo.write(records.tobytes())
@@ -139,6 +145,7 @@ def render_rsm(ctx, programs, scene: Scene, geometry, textures, shadows, resolut
         out.views_ssbo = ssbo(ctx, records)
     out.tiles, out.views, out.drawn = tiles, rows, len(draws)
     out.positions, out.geometry, out.partial = scene.positions, geometry, sum(r is not None for r in draws.values())
+    out.generation, out.redrawn = (out.generation + 1, list(draws.items())) if plan is not None else (0, None)
     return out
 
 

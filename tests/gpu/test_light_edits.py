@@ -87,7 +87,7 @@ def test_moving_an_object_keeps_the_emitters_and_sky_views_while_the_bounds_hold
     """The sky's shadow views and the emitters' lights (light_sources) depend on the emissive triangles and the
     scene's bounds (common/lights.static_key), not on where a non-emitting object stands inside them: moving the box
     keeps them, redraws in each depth map and RSM view only the rectangle the box's old and new places cover
-    (direct/shadows.moved_rect), and the maps and Diffuse Direct are still exactly a cold render's; lifting it
+    (direct/shadows.moved_rects), and the maps and Diffuse Direct are still exactly a cold render's; lifting it
     above everything else grows the bounds, and they are made again."""
     from bounce_gi.gpu_kernels.settings import RenderSettings
 

@@ -14,11 +14,11 @@ import pytest
 
 from bounce_gi.gpu_kernels.engine import Engine
 from bounce_gi.gpu_kernels.gl.bind import read_texture
-from bounce_gi.gpu_kernels.lpv import lighting, receivers, regional, transfer_update
+from bounce_gi.gpu_kernels.lpv import lighting, receivers, transfer_update
 from bounce_gi.gpu_kernels.lpv.settings import LpvSettings
 from bounce_gi.gpu_kernels.scene import Light, Material, World
 from bounce_gi.gpu_kernels.settings import RenderSettings
-from support.synthetic import box_quads, quad_scene
+from support.synthetic import box_quads, quad_scene, room_with_box
 
 GEOMETRY_PASSES = ("geometry", "geometry_volume", "lpv_transfer")
 SETTINGS = RenderSettings("lpv", 48, 36, lpv=LpvSettings(resolution=16))
@@ -105,39 +105,6 @@ def test_a_transfer_too_large_for_its_budget_gathers_instead():
     assert "vpls" in r.info["cascades"][0]["bounces"][0]
 
 
-def _room_with_box(z, size=0.3):
-    """The room of _room with a `size` m box standing `z` m above the floor by the wall."""
-    quads = box_quads((-1, -1, 0), (1, 1, 2), 0, skip=((2, "hi"),)) + \
-        box_quads((0.8 - size, 0.8 - size, z), (0.8, 0.8, z + size), 1, inward=False)
-    bulb = np.eye(4)
-    bulb[:3, 3] = (-0.4, 0.2, 1.4)
-    return quad_scene(quads, [Material("floor", (0.7, 0.7, 0.7)), Material("box", (0.8, 0.3, 0.2))],
-                      [Light("bulb", "POINT", (1, 1, 1), 60.0, bulb)], (0.0, -0.95, 1.0), (0.0, 0.5, 0.6),
-                      lens=12.0)
-
-
-def test_an_objects_move_voxelises_only_the_region_it_changed(monkeypatch):
-    """The box moved 5 cm: the geometry volume voxelises again only the voxels the box left and entered, grown by
-    one (lpv/regional.py: under a tenth of the fine grid here), into its kept voxelisation — and its receivers are a
-    cold render's, byte for byte, and so is the light (to float32 rounding, like every cached edit)."""
-    regions, moved_region = [], regional.moved_region
-    monkeypatch.setattr(regional, "moved_region", lambda *a: regions.append(moved_region(*a)) or regions[-1])
-    engine, cold = Engine(), Engine()
-    engine.render(_room_with_box(0.0), SETTINGS)
-    moved = engine.render(_room_with_box(0.05), SETTINGS)
-    fresh = cold.render(_room_with_box(0.05), SETTINGS)
-    assert regions[0] is None and regions[2] is None  # nothing kept before the first render of an engine
-    gv, gv_cold = (e.pipeline.cache.entries["geometry_volume"].value[0] for e in (engine, cold))
-    lo, hi = regions[1]
-    assert 0 < np.prod(hi - lo) < 0.1 * np.prod(gv.fine.size)
-    share = np.prod(hi - lo) / np.prod(gv.fine.size)
-    assert moved.info["cascades"][0]["voxelised"] == share and fresh.info["cascades"][0]["voxelised"] == 1.0
-    for name in ("cells", "axis", "surface_normal", "surface_area", "positions", "surface_albedo"):
-        assert np.array_equal(getattr(gv, name), getattr(gv_cold, name)), name
-    assert np.array_equal(gv.bounds[0], gv_cold.bounds[0]) and np.array_equal(gv.bounds[1], gv_cold.bounds[1])
-    _same(_indirect(moved), _indirect(fresh))
-
-
 def _slab_test(a: np.ndarray, b: np.ndarray, box: np.ndarray) -> np.ndarray:
     """Whether segments a → b (broadcast, (..., 3)) meet the axis-aligned box (2, 3), in float64."""
     d = b - a
@@ -163,15 +130,15 @@ def test_moving_an_object_updates_the_transfer_and_matches_a_render_from_scratch
         return got
     monkeypatch.setattr(transfer_update, "box_pairs", checked_box_pairs)
     engine = Engine()
-    before = engine.render(_room_with_box(0.0), SETTINGS)
-    moved = engine.render(_room_with_box(0.05), SETTINGS)
+    before = engine.render(room_with_box(0.0), SETTINGS)
+    moved = engine.render(room_with_box(0.05), SETTINGS)
     print("box pairs (GPU, float64, differing, all):", tested)
     assert len(tested) == 1 and 0 < tested[0][1] < tested[0][3] and tested[0][2] <= 1e-3 * tested[0][1]
     assert np.abs(_indirect(moved) - _indirect(before)).max() > 1e-3 * _indirect(before).mean()  # it did change
     info = moved.info["cascades"][0]
     print("share of T re-evaluated:", info["transfer_updated"])
     assert "lpv_transfer" in _rerun(moved) and 0 < info["transfer_updated"] < 0.5
-    cold = Engine().render(_room_with_box(0.05), SETTINGS)
+    cold = Engine().render(room_with_box(0.05), SETTINGS)
     assert cold.info["cascades"][0]["block"] == info["block"]
     _same(_indirect(moved), _indirect(cold))
 
@@ -183,11 +150,11 @@ def test_an_edit_that_changes_most_of_the_transfer_builds_it_anew_without_updati
     monkeypatch.setattr(transfer_update, "evaluate_pairs", lambda *a: evaluated.append(len(a[-1])))
     monkeypatch.setattr(transfer_update, "update_transfer", lambda *a, **k: updates.append(update(*a, **k)))
     engine = Engine()
-    engine.render(_room_with_box(0.0, size=1.2), SETTINGS)
-    moved = engine.render(_room_with_box(0.3, size=1.2), SETTINGS)
+    engine.render(room_with_box(0.0, size=1.2), SETTINGS)
+    moved = engine.render(room_with_box(0.3, size=1.2), SETTINGS)
     assert "lpv_transfer" in _rerun(moved) and moved.info["cascades"][0]["transfer_updated"] == 1.0
     assert updates == [None] and evaluated == []  # an update was tried, and gave up before evaluating a pair
-    _same(_indirect(moved), _indirect(Engine().render(_room_with_box(0.3, size=1.2), SETTINGS)))
+    _same(_indirect(moved), _indirect(Engine().render(room_with_box(0.3, size=1.2), SETTINGS)))
 
 
 def test_the_dense_light_volumes_and_the_sparse_index_look_up_the_same_light(monkeypatch):

@@ -153,3 +153,15 @@ def sphere_scene(subdivisions=3, radius=1.0, albedo=0.5, power=100.0, eye=(0.0, 
     return Scene(pos, nrm, np.zeros((len(pos), 3, 2), np.float32), np.zeros(len(pos), np.int32),
                  [Material("wall", (albedo,) * 3)], [], [Light("bulb", "POINT", (1, 1, 1), power, np.eye(4))],
                  World(), Camera(cam_to_world, lens=18.0))
+
+
+def room_with_box(z, size=0.3):
+    """A 2 × 2 × 2 m room without a ceiling, lit by a point light, with a `size` m box standing `z` m above the
+    floor by the wall (the LPV's object-move tests)."""
+    quads = box_quads((-1, -1, 0), (1, 1, 2), 0, skip=((2, "hi"),)) + \
+        box_quads((0.8 - size, 0.8 - size, z), (0.8, 0.8, z + size), 1, inward=False)
+    bulb = np.eye(4)
+    bulb[:3, 3] = (-0.4, 0.2, 1.4)
+    return quad_scene(quads, [Material("floor", (0.7, 0.7, 0.7)), Material("box", (0.8, 0.3, 0.2))],
+                      [Light("bulb", "POINT", (1, 1, 1), 60.0, bulb)], (0.0, -0.95, 1.0), (0.0, 0.5, 0.6),
+                      lens=12.0)

@@ -49,6 +49,12 @@ uniform int u_slot_base;
 // lpv/passes.py first_bounce); a block's texels all belong to one view, so one test per block.
 uniform bool u_masked;
 layout(std430, binding = 7) readonly buffer LightMask { uint light_mask[]; };
+#if defined(BLOCK_LIST)
+// Listed blocks instead of a rectangle, one per invocation, block k's records in slots 2k and 2k + 1 (lpv/gather.
+// rsm_records with rects: after an object's move, the blocks it covers in every view, in one dispatch).
+layout(std430, binding = 11) readonly buffer BlockList { ivec2 block_list[]; };
+uniform int u_list_count;
+#endif
 #endif
 // The flux per unit of each light's colour (colour × power or strength = 1), its light's index in the record's
 // flux.w (MODE_LIST): the LPV's cached transport bins each light's records once and scales them by its colour.
@@ -160,9 +166,15 @@ void main() {
     // mean would float in the air between them, so texels off the plane of the block's first lit texel (normal
     // more than ~25° away, or more than half a cell from its plane) form a second VPL. Blocks never straddle views:
     // tiles are multiples of 16 texels and k divides 16.
-#if defined(MODE_LIST)
+#if defined(BLOCK_LIST)
+    int item = int(gl_WorkGroupID.x) * 64 + int(gl_LocalInvocationIndex);
+    if (item >= u_list_count) return;
+    ivec2 block = block_list[item];
+    int slot = 2 * item;
+#elif defined(MODE_LIST)
     if (any(greaterThanEqual(ivec2(gl_GlobalInvocationID.xy), u_block_count))) return;
     ivec2 block = ivec2(gl_GlobalInvocationID.xy) + u_block_origin;
+    int slot = u_slot_base + 2 * ((block.y - u_row_base) * u_blocks_x + block.x);
 #else
     ivec2 block = ivec2(gl_GlobalInvocationID.xy);
 #endif
@@ -202,8 +214,7 @@ void main() {
     for (int c = 0; c < 2; ++c) {
         if (weight[c] <= 0.0 || dot(normal[c], normal[c]) == 0.0) continue;
 #if defined(MODE_LIST)
-        vpls[u_slot_base + 2 * ((block.y - u_row_base) * u_blocks_x + block.x) + c] = Vpl(vec4(position[c] / weight[c], 1.0),
-                                                              vec4(normalize(normal[c]), 0.0), vec4(flux[c], light));
+        vpls[slot + c] = Vpl(vec4(position[c] / weight[c], 1.0), vec4(normalize(normal[c]), 0.0), vec4(flux[c], light));
 #else
         inject_lambertian(LpvGrid(u_grid_origin, u_grid_cell, u_grid_size), position[c] / weight[c],
                           normalize(normal[c]), flux[c]);

@@ -1,0 +1,74 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""What an object's move redraws and re-makes: the rectangles its box covers in the shadow and RSM views
+(direct/shadows.moved_rects) and the RSM records merged from the kept ones and those of the redrawn blocks
+(lpv/gather.merge_records). The GPU side, against cold renders: tests/gpu/test_light_edits.py and
+tests/gpu/test_lpv_transfer.py."""
+import numpy as np
+
+from bounce_gi.gpu_kernels.common.lights import cube_views
+from bounce_gi.gpu_kernels.direct.shadows import MOVED_MARGIN, moved_rects
+from bounce_gi.gpu_kernels.lpv.gather import VPL_DTYPE, covered_blocks, merge_records
+
+
+def _one_view(view, box, tile):
+    """The rectangle of one view, written plainly: corners projected one by one."""
+    pts = []
+    for x in box[:, 0]:
+        for y in box[:, 1]:
+            for z in box[:, 2]:
+                c = np.asarray(view.view_projection, np.float64) @ np.array([x, y, z, 1.0])
+                if c[3] <= 1e-9 * np.abs(c[:3]).max(initial=1.0):
+                    return tuple(tile)
+                pts.append(c[:2] / c[3])
+    pts = np.array(pts)
+    tx, ty, tw, th = tile
+    lo = np.maximum(np.floor([tx + (pts[:, 0].min() * 0.5 + 0.5) * tw, ty + (pts[:, 1].min() * 0.5 + 0.5) * th])
+                    - MOVED_MARGIN, [tx, ty])
+    hi = np.minimum(np.ceil([tx + (pts[:, 0].max() * 0.5 + 0.5) * tw, ty + (pts[:, 1].max() * 0.5 + 0.5) * th])
+                    + MOVED_MARGIN, [tx + tw, ty + th])
+    if np.any(hi <= lo):
+        return None
+    return int(lo[0]), int(lo[1]), int(hi[0] - lo[0]), int(hi[1] - lo[1])
+
+
+def test_every_views_rectangle_is_the_one_its_own_projection_gives():
+    """Random boxes against a cube's six faces from random eyes (boxes beside, around and behind the eye): the
+    views projected together give each view's rectangle exactly as projecting that view alone does."""
+    rng = np.random.default_rng(3)
+    tiles = [(64 * i, 32, 64, 64) for i in range(6)]
+    seen = set()
+    for _ in range(300):
+        views = cube_views(rng.normal(0, 2, 3), 64, 0.01, 20.0)
+        lo = rng.normal(0, 2, 3)
+        box = np.stack([lo, lo + rng.uniform(0.01, 1.5, 3)])
+        got = moved_rects(views, box, tiles)
+        want = [_one_view(v, box, t) for v, t in zip(views, tiles)]
+        assert got == want
+        seen.update("none" if r is None else "whole" if r == tuple(t) else "part" for r, t in zip(got, tiles))
+    assert seen == {"none", "whole", "part"}
+
+
+def test_merged_records_are_the_kept_ones_outside_the_redrawn_blocks_and_the_new_ones_inside():
+    """An atlas of 16 × 8 blocks (k = 2 texels), two planes a block: records kept from before everywhere, then two
+    rectangles redrawn with new records (some blocks now empty, some with records where there were none): the merge
+    holds exactly the new records inside the rectangles' blocks and the old ones elsewhere, in slot order."""
+    rng = np.random.default_rng(8)
+    k, blocks_x, blocks_y = 2, 16, 8
+
+    def records(slots, tag):
+        r = np.zeros(len(slots), VPL_DTYPE)
+        r["flux"][:, 0], r["flux"][:, 1] = tag, slots
+        return r
+    old_slots = np.sort(rng.choice(2 * blocks_x * blocks_y, 150, replace=False))
+    rects = [(4, 2, 6, 4), (20, 10, 5, 3)]  # atlas texels: blocks x 2..4, y 1..2 and x 10..12, y 5..6
+    inside = np.zeros((blocks_y, blocks_x), bool)
+    inside[1:3, 2:5] = inside[5:7, 10:13] = True
+    candidates = np.nonzero(np.repeat(inside.ravel(), 2))[0]
+    new_slots = np.sort(rng.choice(candidates, len(candidates) // 2, replace=False))
+    redone = covered_blocks(rects, k, (blocks_x, blocks_y))
+    assert np.array_equal(redone, inside.ravel())
+    got, slots = merge_records((records(old_slots, 1.0), old_slots), (records(new_slots, 2.0), new_slots), redone)
+    in_new = np.repeat(inside.ravel(), 2)
+    want = np.sort(np.concatenate([old_slots[~in_new[old_slots]], new_slots]))
+    assert np.array_equal(slots, want) and np.array_equal(got["flux"][:, 1], want)
+    assert np.array_equal(got["flux"][:, 0], np.where(in_new[want], 2.0, 1.0))
