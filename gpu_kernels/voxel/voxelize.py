@@ -254,10 +254,11 @@ def _front_most(ctx, programs, scene, geometry, textures, grid, supersample, reg
     zero_texture(ctx, front)
     front.bind_to_image(6, read=True, write=True)
     uniforms = {"u_grid_origin": grid.origin, "u_inv_cell": 1.0 / grid.cell, "u_grid_size": grid.size,
-                "u_supersample": float(supersample), "u_axis_only": -1}
-    scissor = None if region is None else region_scissor(region, supersample)
-    _draw_raster(ctx, programs, scene, geometry, textures, grid, supersample, uniforms, {"MODE_FRONT": None},
-                 scissor=scissor)
+                "u_supersample": float(supersample)}
+    # A region: each axis's triangles behind that axis's scissor (the union of the three covers most of the image)
+    for axis in (-1,) if region is None else range(3):
+        _draw_raster(ctx, programs, scene, geometry, textures, grid, supersample, {**uniforms, "u_axis_only": axis},
+                     {"MODE_FRONT": None}, scissor=None if region is None else region_scissor(region, supersample, axis))
     ctx.memory_barrier()
     return [front]
 
