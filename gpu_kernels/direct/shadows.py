@@ -141,12 +141,13 @@ def view_rows(views: list) -> np.ndarray:
                     np.float64).reshape(len(views), 20)
 
 
-def redraw_plan(prior, views: list, tiles: list, size: tuple, rows: np.ndarray, positions: np.ndarray | None):
+def redraw_plan(prior, views: list, tiles: list, size: tuple, rows: np.ndarray, positions):
     """What to draw again into `prior` (a DepthAtlas or an RSM, with .tiles, .size, .views and .positions) for
     `views` in `tiles` of an atlas of `size`: (i, rect) per view — rect None for the whole tile, where the view's
-    rows (view_rows) changed; else, where the scene's triangles (`positions`) moved since `prior` was drawn, the
-    rectangle they can cover (moved_rects). None where `prior` cannot be updated (none, tiled otherwise, another
-    triangle count): draw everything."""
+    rows (view_rows) changed; else, where the scene's triangles (`positions`, or a tuple of them and what else the
+    atlas holds of each triangle: moved_box) changed since `prior` was drawn, the rectangle they can cover
+    (moved_rects). None where `prior` cannot be updated (none, tiled otherwise, another triangle count): draw
+    everything."""
     if prior is None or prior.tiles != tiles or prior.size != size:
         return None
     box = None if positions is None else moved_box(prior.positions, positions)
@@ -209,17 +210,21 @@ def render_depth(ctx, programs, geometry: GeometryBuffers, views: list, tiles: l
     return DepthAtlas(depth, tiles, size, rows, len(draws), positions)
 
 
-def moved_box(before: np.ndarray | None, after: np.ndarray):
+def moved_box(before, after):
     """The world box (2, 3) of the triangles that differ between two (T, 3, 3) position arrays, before and after;
-    None where none does; False where they cannot be compared (another triangle count, or no record)."""
-    if before is None or before.shape != after.shape:
+    None where none does; False where they cannot be compared (another triangle count, or no record). Either may be
+    a tuple of the positions and other per-triangle arrays (normals, UVs, material indices) whose change counts too:
+    an RSM holds each texel's normal, texture colour and material, so a material given to an object changes it."""
+    before, after = (x if isinstance(x, tuple) else (x,) for x in (before, after))
+    if before[0] is None or len(before) != len(after) or any(a.shape != b.shape for a, b in zip(before, after)):
         return False
-    if before is after:
-        return None
-    changed = np.any(before != after, axis=(1, 2))
+    changed = np.zeros(len(after[0]), bool)
+    for a, b in zip(before, after):
+        if a is not b:
+            changed |= np.any((a != b).reshape(len(b), -1), axis=1)
     if not changed.any():
         return None
-    corners = np.concatenate([before[changed], after[changed]]).reshape(-1, 3).astype(np.float64)
+    corners = np.concatenate([before[0][changed], after[0][changed]]).reshape(-1, 3).astype(np.float64)
     return np.stack([corners.min(axis=0), corners.max(axis=0)])
 
 

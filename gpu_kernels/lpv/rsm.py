@@ -30,7 +30,7 @@ class Rsm:
     tiles: list = None  # each view's tile (x, y, w, h)
     views: np.ndarray = None  # (N, 20) what each tile was drawn from (direct/shadows.view_rows)
     drawn: int = 0  # views drawn (whole or in part) when it was last made or updated
-    positions: np.ndarray = None  # the scene's triangles it was drawn from (Scene.positions)
+    positions: tuple = None  # the scene's triangles it was drawn from: positions, normals, UVs, materials
     geometry: object = None  # the GeometryBuffers `vao` draws
     partial: int = 0  # of the views drawn, those drawn in a rectangle only (an object's move: moved_rects)
     # Updates drawn into this atlas since it was made, and what the last one drew: (view, rect or None for its
@@ -106,7 +106,8 @@ def render_rsm(ctx, programs, scene: Scene, geometry, textures, shadows, resolut
            for v, light in zip(views, view_lights)]
     tiles, size, scale = atlas.allocate_atlas(res, max_height=ctx.info.get("GL_MAX_TEXTURE_SIZE", 16384))
     tiles, size, rows = [tuple(t) for t in tiles], tuple(size), shadows.rows
-    plan = redraw_plan(prior, views, tiles, size, rows, scene.positions)
+    surfaces = (scene.positions, scene.normals, scene.uvs, scene.material_index)  # what its texels hold
+    plan = redraw_plan(prior, views, tiles, size, rows, surfaces)
     out = prior if plan is not None else _new_rsm(ctx, programs, geometry, size, resolution // scale)
     if out.geometry is not geometry:  # the geometry's buffers were made again: draw from the new ones
         out.vao.release()
@@ -144,7 +145,7 @@ def render_rsm(ctx, programs, scene: Scene, geometry, textures, shadows, resolut
             out.views_ssbo.release()
         out.views_ssbo = ssbo(ctx, records)
     out.tiles, out.views, out.drawn = tiles, rows, len(draws)
-    out.positions, out.geometry, out.partial = scene.positions, geometry, sum(r is not None for r in draws.values())
+    out.positions, out.geometry, out.partial = surfaces, geometry, sum(r is not None for r in draws.values())
     out.generation, out.redrawn = (out.generation + 1, list(draws.items())) if plan is not None else (0, None)
     return out
 

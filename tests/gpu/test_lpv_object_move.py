@@ -8,7 +8,7 @@ import numpy as np
 from bounce_gi.gpu_kernels.engine import Engine
 from bounce_gi.gpu_kernels.lpv import gather, regional
 from bounce_gi.gpu_kernels.lpv.settings import LpvSettings
-from bounce_gi.gpu_kernels.scene import Light
+from bounce_gi.gpu_kernels.scene import Light, Material
 from bounce_gi.gpu_kernels.settings import RenderSettings
 from support.synthetic import room_with_box
 
@@ -67,3 +67,18 @@ def test_an_objects_move_makes_again_only_the_records_of_the_texels_it_covers(mo
     kept, new = (e.pipeline.cache.entries["lpv_inject"].value.records[0] for e in (engine, cold))
     assert np.array_equal(kept[1], new[1]) and kept[0].tobytes() == new[0].tobytes()
     _same(_indirect(moved), _indirect(fresh))
+
+
+def test_a_material_given_to_an_object_is_drawn_into_the_kept_maps():
+    """The box given a third material, nothing moved: the RSM holds each texel's material, so the texels of the
+    triangles whose material (or normals, or UVs) changed are drawn again like a moved object's — the light is a
+    cold render's."""
+    def scene(material):
+        s = room_with_box(0.0)
+        mats = np.where(s.material_index == 1, material, s.material_index).astype(np.int32)
+        return replace(s, material_index=mats, materials=s.materials + [Material("blue", (0.1, 0.2, 0.9))])
+    engine = Engine()
+    before = engine.render(scene(1), SETTINGS)
+    after = engine.render(scene(2), SETTINGS)
+    assert np.abs(_indirect(after) - _indirect(before)).max() > 1e-3 * _indirect(before).mean()  # it did change
+    _same(_indirect(after), _indirect(Engine().render(scene(2), SETTINGS)))
