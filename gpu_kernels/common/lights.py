@@ -200,9 +200,14 @@ def spot_view(scene: Scene, light: Light, resolution: int, near: float, far: flo
                       2 * math.tan(fov / 2) / resolution, resolution, far, view, math.tan(fov / 2))
 
 
+# Far planes rounded up to a power of FAR_STEP: an object moved at the scene's edge grows its bounds a little, and
+# far planes that followed changed every lamp's views, so every map and RSM was drawn again (maps hold distance / far).
+FAR_STEP = 2.0 ** 0.125
+
+
 def _near_far(scene: Scene, origin) -> tuple[float, float]:
     centre, radius = _scene_radius(scene)
-    far = float(np.linalg.norm(np.asarray(origin) - centre)) + radius * 1.01
+    far = FAR_STEP ** math.ceil(math.log(float(np.linalg.norm(np.asarray(origin) - centre)) + radius * 1.01, FAR_STEP))
     return far * 1e-4, far  # relative only: a metre-valued floor here clipped millimetre scenes' shadow maps
 
 
