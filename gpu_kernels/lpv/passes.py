@@ -259,6 +259,8 @@ def texel_records(ctx, programs, maps, shadows, materials, grid, kept, cascade, 
     k = gather.block_size(maps, clusters.TEXEL_RECORDS)
     redone = gather.covered_blocks([maps.tiles[i] if rect is None else rect for i, rect in maps.redrawn], k,
                                    (-(-maps.size[0] // k), -(-maps.size[1] // k)))
+    if not redone.any():  # nothing the RSM holds was drawn again (the triangles changed out of every view)
+        return kept.records[cascade]
     records, _, slots = gather.rsm_records(*args, unit_color=True, blocks=redone, with_slots=True)
     return gather.merge_records(kept.records[cascade], (records, slots), redone)
 

@@ -82,3 +82,23 @@ def test_a_material_given_to_an_object_is_drawn_into_the_kept_maps():
     after = engine.render(scene(2), SETTINGS)
     assert np.abs(_indirect(after) - _indirect(before)).max() > 1e-3 * _indirect(before).mean()  # it did change
     _same(_indirect(after), _indirect(Engine().render(scene(2), SETTINGS)))
+
+
+def test_an_object_moved_out_of_every_view_keeps_every_record(monkeypatch):
+    """A spot light shining at the far corner of the floor, the box moved by the other wall, out of its cone: no
+    texel of its maps is drawn again and every record is kept as it was (none made) — and the light is a cold
+    render's, the transfer's update carrying the box's own change."""
+    calls, rsm_records = [], gather.rsm_records
+    monkeypatch.setattr(gather, "rsm_records", lambda *a, **k: calls.append(k.get("blocks")) or rsm_records(*a, **k))
+    spot = np.eye(4)  # at (−0.6, −0.6, 1.8), shining straight down, a 30° cone: the floor's far corner
+    spot[:3, 3] = (-0.6, -0.6, 1.8)
+
+    def scene(z):
+        s = room_with_box(z)
+        return replace(s, lights=[Light("spot", "SPOT", (1, 1, 1), 80.0, spot, spot_size=np.radians(30.0))])
+    engine = Engine()
+    engine.render(scene(0.0), SETTINGS)
+    moved = engine.render(scene(0.05), SETTINGS)
+    assert len(calls) == 1  # the first render's; the move made none
+    assert engine.pipeline.cache.entries["rsm"].value.redrawn == []
+    _same(_indirect(moved), _indirect(Engine().render(scene(0.05), SETTINGS)))
