@@ -128,7 +128,7 @@ class DepthAtlas:
     size: tuple
     views: np.ndarray
     drawn: int = 0  # views drawn (whole or in part) when it was last made or updated
-    positions: np.ndarray = None  # the scene's triangles it was drawn from (Scene.positions)
+    drawn_from: np.ndarray = None  # the scene's triangles it was drawn from (Scene.positions)
     partial: int = 0  # of the views drawn, those drawn in a rectangle only (an object's move: moved_rects)
 
     def release(self):
@@ -142,7 +142,7 @@ def view_rows(views: list) -> np.ndarray:
 
 
 def redraw_plan(prior, views: list, tiles: list, size: tuple, rows: np.ndarray, positions):
-    """What to draw again into `prior` (a DepthAtlas or an RSM, with .tiles, .size, .views and .positions) for
+    """What to draw again into `prior` (a DepthAtlas or an RSM, with .tiles, .size, .views and .drawn_from) for
     `views` in `tiles` of an atlas of `size`: (i, rect) per view — rect None for the whole tile, where the view's
     rows (view_rows) changed; else, where the scene's triangles (`positions`, or a tuple of them and what else the
     atlas holds of each triangle: moved_box) changed since `prior` was drawn, the rectangle they can cover
@@ -150,7 +150,7 @@ def redraw_plan(prior, views: list, tiles: list, size: tuple, rows: np.ndarray, 
     everything."""
     if prior is None or prior.tiles != tiles or prior.size != size:
         return None
-    box = None if positions is None else moved_box(prior.positions, positions)
+    box = None if positions is None else moved_box(prior.drawn_from, positions)
     if box is False:
         return None
     whole = np.any(rows != prior.views, axis=1)
@@ -205,7 +205,7 @@ def render_depth(ctx, programs, geometry: GeometryBuffers, views: list, tiles: l
         fbo.release()
     partial = sum(rect is not None for _, rect in draws)
     if plan is not None:
-        prior.views, prior.drawn, prior.positions, prior.partial = rows, len(draws), positions, partial
+        prior.views, prior.drawn, prior.drawn_from, prior.partial = rows, len(draws), positions, partial
         return prior
     return DepthAtlas(depth, tiles, size, rows, len(draws), positions)
 

@@ -30,7 +30,7 @@ class Rsm:
     tiles: list = None  # each view's tile (x, y, w, h)
     views: np.ndarray = None  # (N, 20) what each tile was drawn from (direct/shadows.view_rows)
     drawn: int = 0  # views drawn (whole or in part) when it was last made or updated
-    positions: tuple = None  # the scene's triangles it was drawn from: positions, normals, UVs, materials
+    drawn_from: tuple = None  # the scene's triangles it was drawn from: positions, normals, UVs, materials
     geometry: object = None  # the GeometryBuffers `vao` draws
     partial: int = 0  # of the views drawn, those drawn in a rectangle only (an object's move: moved_rects)
     # Updates drawn into this atlas since it was made, and what the last one drew: (view, rect or None for its
@@ -145,7 +145,7 @@ def render_rsm(ctx, programs, scene: Scene, geometry, textures, shadows, resolut
             out.views_ssbo.release()
         out.views_ssbo = ssbo(ctx, records)
     out.tiles, out.views, out.drawn = tiles, rows, len(draws)
-    out.positions, out.geometry, out.partial = surfaces, geometry, sum(r is not None for r in draws.values())
+    out.drawn_from, out.geometry, out.partial = surfaces, geometry, sum(r is not None for r in draws.values())
     out.generation, out.redrawn = (out.generation + 1, list(draws.items())) if plan is not None else (0, None)
     return out
 
