@@ -63,6 +63,7 @@ def inject(ctx, programs, scene: Scene, geometry, textures: list, vox, shadows, 
             prog = programs.compute("vct/inject.glsl", {"MODE_RESOLVE": None, **defines})
             unit = bind_samplers(prog, "u_area", [vox.area], 0)
             unit = bind_samplers(prog, "u_albedo", [vox.albedo], unit)
+            unit = bind_samplers(prog, "u_normal", [vox.normal], unit)
             unit = bind_samplers(prog, "u_acc", [acc], unit)
             bind_lights(prog, shadows, unit, sky_stride=SKY_INJECTION_STRIDE)
             bind_grid(prog, grid, 1)

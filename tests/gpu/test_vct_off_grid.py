@@ -37,6 +37,22 @@ def test_a_room_turned_off_the_grid_keeps_its_light(engine):
     assert indirect >= 0.84 and escaped <= 0.10
 
 
+@pytest.mark.parametrize("degrees, least", [(20.0, 0.76), (30.0, 0.69)])
+def test_a_turned_room_keeps_its_light_over_many_bounces(engine, degrees, least):
+    """The closed furnace of albedo 0.8 turned off the axes, 8 bounces: Diffuse Indirect = Le·Σ_{j=1..8} 0.8^j
+    exactly. The bounces after the first are gathered at the voxels by the volumetric march (trace_cone), which
+    composites each voxel of a tilted wall's staircase as an independent layer; neighbours along a column cover
+    complementary parts of it, so their coverages must add (vct/inject.glsl column_area), or every gather loses
+    light through the wall. Measured at 32³ with the column sum: 0.781 (20°) and 0.719 (30°) of the exact value;
+    without it 0.735 and 0.619 (axis-aligned: 0.976). The bounds lie between the two."""
+    rho = 0.8
+    r = _render(engine, turned(furnace(rho, 1.0), degrees), bounces=8)
+    hit = r.passes["Depth"][..., 0] < 1e9
+    share = float(r.passes["Diffuse Indirect"][..., 0][hit].mean()) / sum(rho ** j for j in range(1, 9))
+    print(f"furnace turned {degrees}°, 8 bounces: {share:.3f} of the exact value")
+    assert share >= least
+
+
 def test_a_closed_sphere_first_bounce_is_uniform_and_near_exact(engine):
     """Inside a closed sphere of albedo ρ lit by a point light of flux Φ at its centre, the one-bounce irradiance is
     E₁ = ρΦ/(4πR²) everywhere (every pair of points on a sphere has the same form factor). Curved walls are what
