@@ -56,7 +56,8 @@ float view_test(int view_index, vec3 p, vec3 geo_n, vec3 to_light, float max_slo
     // texel at all: only the dilation keeps the sky out along a zero-thickness wall parallel to a direction). It
     // darkens each direction's visible region by a texel on every side: a few percent under a skylight.
     if (r == 0) {  // the stored depths compared here as the atlas's "<=" comparison would
-        vec4 z = textureGather(u_shadow_depth, clamp(atlas_uv, lo, hi), 0);
+        // a texel short of the far edges: a gather there would read the next tile's first texels
+        vec4 z = textureGather(u_shadow_depth, clamp(atlas_uv, lo, hi - 0.5 * u_atlas_texel), 0);
         gap = depth - min(min(z.x, z.y), min(z.z, z.w));
         return gap <= 0.0 ? 1.0 : 0.0;
     }
@@ -135,8 +136,9 @@ float patch_visibility(int view_index, vec3 p, vec3 geo_n, vec3 to_light, float 
     vec3 c0 = view_uv_depth(v, q), ca = view_uv_depth(v, q + t1 * step_m), cb = view_uv_depth(v, q + t2 * step_m);
     mat2 jac = mat2(ca.xy - c0.xy, cb.xy - c0.xy);
     vec2 grad = abs(determinant(jac)) > 1e-20 ? vec2(ca.z - c0.z, cb.z - c0.z) * inverse(jac) : vec2(0.0);
+    // Gathers read the 2 × 2 texels around their point: points within [lo, hi] keep them inside the tile.
     vec2 lo = v.tile.xy + 0.5 * u_atlas_texel;
-    vec2 hi = v.tile.xy + v.tile.zw - 0.5 * u_atlas_texel;
+    vec2 hi = v.tile.xy + v.tile.zw - 1.5 * u_atlas_texel;
     // The nearest blocker among 20 texels over that region sets how far the patch's shadow can reach: the
     // backprojection's region, over which its gathers are spread as densely as that allows.
     float nearest = 2.0;
