@@ -16,7 +16,8 @@ Passes and their inputs (a pass re-runs only when one of its inputs changed — 
     sky_visibility← geometry, shading, camera, the sky's shadow views (its visible shares: a world colour edit or
                     another light's move keeps them)
     direct_light  ← geometry, shading, camera, shadow_maps, sky_visibility (scene.material_keys: a dielectric's
-                    base colour edit keeps both)
+                    base colour edit keeps both); after an object's move, the pixels it cannot change keep their light
+                    (direct/lighting.Relight)
     <method>      ← the above (lpv/passes.py, vct/passes.py: the indirect light)
     compose       ← everything above, world      (CPU: passes as numpy, Combined)
 
@@ -170,7 +171,7 @@ class Pipeline:
         start = time.perf_counter()
         self.cache.begin_frame()
         frame = self._direct_passes(scene, settings)
-        direct_tex = self._direct_light(frame, frame.textures.lut)
+        direct_tex = self._direct_light(frame, frame.textures.lut, camera=True)
         out = self._method_output(frame)
 
         def compose():
@@ -235,10 +236,11 @@ class Pipeline:
         tex = self._direct_light(frame, None)
         return tex["diffuse"][::-1], frame
 
-    def _direct_light(self, frame, material_lut) -> dict:
+    def _direct_light(self, frame, material_lut, camera: bool = False) -> dict:
         """The direct_light pass, and before it the sky light's visibility, kept apart (sky_visibility): it depends
         on the G-buffer and the sky's own shadow maps, not on any light's colour nor on the other lights, so a world
-        or light colour edit and another light's move skip it."""
+        or light colour edit and another light's move skip it. `camera`: the G-buffer is the camera's (an object's
+        move then re-lights only the pixels it can change: _relight)."""
         sky = self.cache.run("sky_visibility", (frame.keys["direct"][0], sh.sky_key(frame.shadows)),
                              lambda: lighting.render_sky_visibility(self.ctx, self.programs, frame.gbuffer,
                                                                     frame.shadows, material_lut))
@@ -246,8 +248,31 @@ class Pipeline:
         # the kept output of the same G-buffer and shadow settings, a light's edit re-lights that light alone.
         prior = self.cache.prior("direct_light", lambda k: k[0] == frame.keys["direct"][0]
                                  and k[1][4] == frame.keys["shadow"][4])
-        return self.cache.run("direct_light", frame.keys["direct"], lambda: lighting.render_direct_light(
-            self.ctx, self.programs, frame.gbuffer, frame.shadows, material_lut, sky, prior))
+        relight = self._relight(frame) if camera and prior is None else None
+        maps, scene = frame.shadows.maps, frame.scene
+        made_from = (maps.serial, maps.generation, (scene.positions, scene.normals, scene.uvs, scene.material_index),
+                     frame.keys["gbuffer"])
+        return self.cache.run("direct_light", frame.keys["direct"], lambda: {**lighting.render_direct_light(
+            self.ctx, self.programs, frame.gbuffer, frame.shadows, material_lut, sky, prior, relight),
+            "made_from": made_from})
+
+    def _relight(self, frame) -> lighting.Relight | None:
+        """After an object's move, the kept Diffuse Direct of the same camera, materials and shadow settings, lit
+        from the same depth atlas one update ago, with where the move can change it (lighting.Relight); else None."""
+        keys, maps = frame.keys, frame.shadows.maps
+        kept = self.cache.prior("direct_light", lambda k: k[0][1:] == keys["direct"][0][1:]
+                                and k[1][4] == keys["shadow"][4])
+        if kept is None or maps.redrawn is None:
+            return None
+        serial, generation, surfaces, gbuffer_key = kept["made_from"]
+        if (serial, generation + 1) != (maps.serial, maps.generation) or gbuffer_key[1:] != keys["gbuffer"][1:]:
+            return None
+        scene = frame.scene
+        box = sh.moved_box(surfaces, (scene.positions, scene.normals, scene.uvs, scene.material_index))
+        if box is False:
+            return None
+        w, h = frame.gbuffer.size
+        return lighting.Relight(kept, (0, 0, 0, 0) if box is None else gb.box_pixels(scene, w, h, box), maps.redrawn)
 
     @staticmethod
     def _method_output(frame):

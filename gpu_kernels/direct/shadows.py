@@ -3,7 +3,8 @@
 (common/lights.py builds them; direct/eval.glsl reads them)."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+import itertools
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -29,6 +30,7 @@ class ShadowAtlas:
     views_key: str = ""  # views_key: what the maps and records are besides the lights' colours
     light_keys: list = None  # light_signatures: the same, per light
     rows: np.ndarray = None  # view_rows of buffers.views: what each view's maps are drawn from
+    maps: object = None  # the DepthAtlas `depth` belongs to (its serial, generation and last redraw)
     _raw: object = None
 
     def raw_depth(self):
@@ -74,11 +76,12 @@ def render_shadow_atlas(ctx, programs, scene: Scene, geometry: GeometryBuffers,
         return render_depth(ctx, programs, geometry, buffers.views, tiles, size, prior, rows, scene.positions)
 
     key = depth_key(rows, tiles, size)
-    depth = (render() if depth_pass is None else depth_pass(key, render)).texture
+    maps = render() if depth_pass is None else depth_pass(key, render)
     views = atlas.pack_views(buffers.views, tiles, size, settings.pcf_radius, buffers.view_lights)
-    return ShadowAtlas(depth, size, ssbo(ctx, buffers.lights), ssbo(ctx, views), ssbo(ctx, buffers.polygon_vertices),
-                       len(buffers.lights), len(buffers.views), warnings, buffers, owns_depth=depth_pass is None,
-                       views_key=views_key(buffers, key, views), light_keys=light_signatures(buffers, views), rows=rows)
+    return ShadowAtlas(maps.texture, size, ssbo(ctx, buffers.lights), ssbo(ctx, views),
+                       ssbo(ctx, buffers.polygon_vertices), len(buffers.lights), len(buffers.views), warnings, buffers,
+                       owns_depth=depth_pass is None, views_key=views_key(buffers, key, views),
+                       light_keys=light_signatures(buffers, views), rows=rows, maps=maps)
 
 
 def light_signatures(buffers: lb.LightBuffers, packed: np.ndarray) -> list:
@@ -130,6 +133,12 @@ class DepthAtlas:
     drawn: int = 0  # views drawn (whole or in part) when it was last made or updated
     drawn_from: np.ndarray = None  # the scene's triangles it was drawn from (Scene.positions)
     partial: int = 0  # of the views drawn, those drawn in a rectangle only (an object's move: moved_rects)
+    # Which atlas this is and how many updates it has had; `redrawn`: the last update's (view, rect) pairs (rect
+    # (x, y, w, h) in atlas texels, None for the whole tile), None when it was drawn whole. What was lit from the
+    # atlas one update ago may keep its pixels that read none of those texels (direct/lighting.Relight).
+    serial: int = field(default_factory=itertools.count().__next__)
+    generation: int = 0
+    redrawn: list = None
 
     def release(self):
         self.texture.release()
@@ -206,6 +215,7 @@ def render_depth(ctx, programs, geometry: GeometryBuffers, views: list, tiles: l
     partial = sum(rect is not None for _, rect in draws)
     if plan is not None:
         prior.views, prior.drawn, prior.drawn_from, prior.partial = rows, len(draws), positions, partial
+        prior.generation, prior.redrawn = prior.generation + 1, draws
         return prior
     return DepthAtlas(depth, tiles, size, rows, len(draws), positions)
 
@@ -231,21 +241,34 @@ def moved_box(before, after):
 MOVED_MARGIN = 2  # texels around a moved box's projection (rasterisation rules at its edges; depth slope)
 
 
+# The twelve edges of a box whose corners are numbered i·4 + j·2 + k (x, y, z picked by bits i, j, k).
+BOX_EDGES = np.array([(c, c | bit) for bit in (1, 2, 4) for c in range(8) if not c & bit])
+
+
 def moved_rects(views: list, box: np.ndarray, tiles: list) -> list:
-    """Per view of `views`, the rectangle (x, y, w, h) of its tile in `tiles` that the world `box` can cover (its
-    corners projected, grown by MOVED_MARGIN texels, within the tile), None where it covers none, the whole tile
-    where a corner lies behind a perspective view's eye: the only texels a triangle inside the box can write. All
-    views at once: an object's move in a sky-lit room tests its box against the sky's 576 views twice (the depth
-    atlas and the RSM), which one view at a time cost 0.4 s."""
+    """Per view of `views`, the rectangle (x, y, w, h) of its tile in `tiles` that the world `box` can cover (grown
+    by MOVED_MARGIN texels, within the tile), None where it covers none: the only texels a triangle inside the box
+    can write. The box is clipped to the view's near plane first (the rasteriser clips the triangles there), so a
+    box reaching behind a cube face's eye covers only what lies in front of it, not the whole tile. All views at
+    once: an object's move in a sky-lit room tests its box against the sky's 576 views twice (the depth atlas and
+    the RSM), which one view at a time cost 0.4 s."""
     if not views:
         return []
     corners = np.array([[box[i][0], box[j][1], box[k][2], 1.0] for i in (0, 1) for j in (0, 1) for k in (0, 1)])
     clip = np.einsum("ck,vjk->vcj", corners, np.stack([np.asarray(v.view_projection, np.float64) for v in views]))
-    behind = np.any(clip[..., 3] <= 1e-9 * np.abs(clip[..., :3]).max(axis=(1, 2), initial=1.0)[:, None], axis=1)
-    ndc = clip[..., :2] / np.where(behind[:, None, None], 1.0, clip[..., 3:4])
+    inside = clip[..., 2] + clip[..., 3]  # ≥ 0 in front of the near plane (z ≥ −w)
+    a, b = BOX_EDGES[:, 0], BOX_EDGES[:, 1]
+    da, db = inside[:, a], inside[:, b]
+    crosses = (da >= 0) != (db >= 0)
+    t = np.where(crosses, da / np.where(crosses, da - db, 1.0), 0.0)[..., None]
+    points = np.concatenate([clip, clip[:, a] + (clip[:, b] - clip[:, a]) * t], axis=1)
+    valid = np.concatenate([inside >= 0, crosses], axis=1) & (points[..., 3] > 0)
+    ndc = points[..., :2] / np.where(valid, points[..., 3], 1.0)[..., None]
+    low = np.where(valid[..., None], ndc, np.inf).min(axis=1)
+    high = np.where(valid[..., None], ndc, -np.inf).max(axis=1)
     t = np.asarray(tiles, np.float64)
-    lo = np.maximum(np.floor(t[:, :2] + (ndc.min(axis=1) * 0.5 + 0.5) * t[:, 2:]) - MOVED_MARGIN, t[:, :2])
-    hi = np.minimum(np.ceil(t[:, :2] + (ndc.max(axis=1) * 0.5 + 0.5) * t[:, 2:]) + MOVED_MARGIN, t[:, :2] + t[:, 2:])
-    return [tuple(tile) if back else None if np.any(b <= a) else (int(a[0]), int(a[1]), int(b[0] - a[0]),
-                                                                   int(b[1] - a[1]))
-            for tile, back, a, b in zip(tiles, behind, lo, hi)]
+    with np.errstate(invalid="ignore"):
+        lo = np.maximum(np.floor(t[:, :2] + (low * 0.5 + 0.5) * t[:, 2:]) - MOVED_MARGIN, t[:, :2])
+        hi = np.minimum(np.ceil(t[:, :2] + (high * 0.5 + 0.5) * t[:, 2:]) + MOVED_MARGIN, t[:, :2] + t[:, 2:])
+    return [None if not v.any() or np.any(h <= l) else (int(l[0]), int(l[1]), int(h[0] - l[0]), int(h[1] - l[1]))
+            for v, l, h in zip(valid, lo, hi)]

@@ -11,16 +11,23 @@ from bounce_gi.gpu_kernels.lpv.gather import VPL_DTYPE, covered_blocks, merge_re
 
 
 def _one_view(view, box, tile):
-    """The rectangle of one view, written plainly: corners projected one by one."""
-    pts = []
-    for x in box[:, 0]:
-        for y in box[:, 1]:
-            for z in box[:, 2]:
-                c = np.asarray(view.view_projection, np.float64) @ np.array([x, y, z, 1.0])
-                if c[3] <= 1e-9 * np.abs(c[:3]).max(initial=1.0):
-                    return tuple(tile)
-                pts.append(c[:2] / c[3])
-    pts = np.array(pts)
+    """The rectangle of one view, written plainly: the box's corners in front of the near plane (z ≥ −w in clip
+    space) and the points where its edges cross that plane, projected one by one."""
+    m = np.asarray(view.view_projection, np.float64)
+    corners = {(i, j, k): m @ np.array([box[i][0], box[j][1], box[k][2], 1.0])
+               for i in (0, 1) for j in (0, 1) for k in (0, 1)}
+    pts = [c for c in corners.values() if c[2] + c[3] >= 0]
+    for (i, j, k), c in corners.items():
+        for other in ((1, j, k), (i, 1, k), (i, j, 1)):
+            if other == (i, j, k):
+                continue
+            d = corners[other]
+            fa, fb = c[2] + c[3], d[2] + d[3]
+            if (fa >= 0) != (fb >= 0):
+                pts.append(c + (d - c) * fa / (fa - fb))
+    pts = np.array([p[:2] / p[3] for p in pts if p[3] > 0])
+    if len(pts) == 0:
+        return None
     tx, ty, tw, th = tile
     lo = np.maximum(np.floor([tx + (pts[:, 0].min() * 0.5 + 0.5) * tw, ty + (pts[:, 1].min() * 0.5 + 0.5) * th])
                     - MOVED_MARGIN, [tx, ty])
@@ -45,7 +52,17 @@ def test_every_views_rectangle_is_the_one_its_own_projection_gives():
         want = [_one_view(v, box, t) for v, t in zip(views, tiles)]
         assert got == want
         seen.update("none" if r is None else "whole" if r == tuple(t) else "part" for r, t in zip(got, tiles))
-    assert seen == {"none", "whole", "part"}
+    assert seen == {"none", "part"}
+    # A box around the eye covers every face whole; one beside it, reaching behind a face's eye plane, covers that
+    # face only where it lies in front (before the near-plane clip: the whole tile, so an object moved beside a
+    # lamp redrew all of its faces).
+    views = cube_views(np.zeros(3), 64, 0.01, 20.0)
+    assert moved_rects(views, np.array([[-1.0, -1, -1], [1, 1, 1]]), tiles) == [tuple(t) for t in tiles]
+    beside = np.array([[-0.2, -0.2, 0.5], [0.2, 0.5, 1.0]])   # in front of +z, across +y's and −y's eye planes
+    rects = moved_rects(views, beside, tiles)
+    assert rects == [_one_view(v, beside, t) for v, t in zip(views, tiles)]
+    parts = [r for r, t in zip(rects, tiles) if r is not None]
+    assert len(parts) == 2 and all(r != tuple(t) for r, t in zip(rects, tiles))
 
 
 def test_merged_records_are_the_kept_ones_outside_the_redrawn_blocks_and_the_new_ones_inside():

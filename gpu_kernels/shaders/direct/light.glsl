@@ -34,6 +34,66 @@ uniform sampler2D u_sky_shares;
 #if defined(MODE_SKY)
 layout(rgba32f, binding = 2) uniform writeonly image2D u_sky_out;
 #endif
+// After an object's move (direct/lighting.Relight) only the pixels it can change are lit again: those inside
+// u_moved_pixels (x0, y0, x1, y1: where the moved triangles can cover the G-buffer) and those whose shadow tests can
+// read a texel that the depth atlas redrew (changed_views: a view of one of this group's lights and its redrawn
+// rectangle). The others write alpha 0 and keep their earlier value. A uniform, not a define: the pixels lit again
+// run the very code a cold render does, so they come out the same to the bit.
+uniform bool u_masked;
+uniform ivec4 u_moved_pixels;
+uniform int u_changed_count;
+struct ChangedView {
+    ivec4 index;   // x: the view, y: its light
+    vec4 rect;     // the texels redrawn, in atlas texels: x0, y0, x1, y1
+};
+layout(std430, binding = 10) readonly buffer ChangedViews { ChangedView changed_views[]; };
+
+// Whether a shadow test of light L at p reads a texel of `c`'s rectangle: q is p biased as the tests bias it (for
+// v0, the view or its cube's first face, whose eye and texel size every face shares), projected into c's view,
+// and the reads reach as far as the PCF radius or a polygon light's blocker search (polygon_visibility's patch of
+// half-size h, at most MAX_SEARCH_SHARE of the map's side), plus a texel of bilinear footprint.
+bool reads_changed(ChangedView c, GpuLight L, ShadowView v0, vec3 q, vec3 p) {
+    ShadowView v = shadow_views[c.index.x];
+    vec4 clip = v.view_projection * vec4(q, 1.0);
+    if (clip.w <= 0.0) return false;   // behind the view's eye: no test reads it
+    vec2 texel = (v.tile.xy + (clip.xy / clip.w * 0.5 + 0.5) * v.tile.zw) / u_atlas_texel;
+    float reach = v.info.y;
+    if (int(L.color_type.w) == LIGHT_POLYGON && L.polygon.z < 0.5) {
+        vec4 e = v0.emitter;
+        float h = 0.5 * sqrt(e.w * max(dot(e.xyz, normalize(p - v0.origin.xyz)), 0.0));
+        reach = max(reach, min(4.0 * h / (length(q - v.origin.xyz) * v.info.x),
+                               MAX_SEARCH_SHARE * v.tile.z / u_atlas_texel.x));
+    }
+    reach += 2.0;
+    return all(greaterThan(texel, c.rect.xy - reach)) && all(lessThan(texel, c.rect.zw + reach));
+}
+
+// Whether no shadow test of this group at p reads a redrawn texel and p's G-buffer texel is not one the move can
+// cover. A cube's tests read the one face its biased point falls in (cube_visibility), so q and that face are
+// found once per cube (changed_views lists the views in order).
+bool unchanged(ivec2 px, vec3 p, vec3 geo_n) {
+    if (all(greaterThanEqual(px, u_moved_pixels.xy)) && all(lessThan(px, u_moved_pixels.zw))) return false;
+    int first = -1, face = -1;
+    vec3 q = p;
+    for (int k = 0; k < u_changed_count; ++k) {
+        ChangedView c = changed_views[k];
+        GpuLight L = lights[c.index.y];
+        int base = int(L.params.y);
+        bool cube = int(L.params.w) == 6;
+        int f = cube ? base + (c.index.x - base) / 6 * 6 : c.index.x;
+        ShadowView v0 = shadow_views[f];
+        if (f != first) {
+            first = f;
+            int type = int(L.color_type.w);
+            vec3 to_light = v0.origin.w > 0.5 ? -L.direction.xyz
+                          : normalize((type == LIGHT_SPOT ? L.position.xyz : v0.origin.xyz) - p);
+            q = biased_point(v0, p, geo_n, to_light, MAX_SLOPE);
+            face = cube ? f + cube_face(q - v0.origin.xyz) : f;
+        }
+        if (c.index.x == face && reads_changed(c, L, v0, q, p)) return false;
+    }
+    return true;
+}
 
 // The sky light's visible shares at p, from one shadow test per direction (direct/eval.glsl sky_direction): x of
 // the cosine weight (irradiance), y (when `lobe_seen`) of the glossy lobe's (direct/ggx.glsl sky_lobe_weight). The
@@ -78,13 +138,20 @@ void main() {
 #if defined(MODE_SKY)
         imageStore(u_sky_out, px, vec4(0.0));
 #else
-        imageStore(u_diffuse_direct, px, vec4(0.0));
-        imageStore(u_glossy_direct, px, vec4(0.0));
+        imageStore(u_diffuse_direct, px, vec4(0.0, 0.0, 0.0, 1.0));
+        imageStore(u_glossy_direct, px, vec4(0.0, 0.0, 0.0, 1.0));
 #endif
         return;
     }
     vec3 n = normalize(texelFetch(u_normal, px, 0).xyz);
     vec3 geo_n = normalize(texelFetch(u_geo_normal, px, 0).xyz);
+#if !defined(MODE_SKY)
+    if (u_masked && unchanged(px, pos.xyz, geo_n)) {
+        imageStore(u_diffuse_direct, px, vec4(0.0));
+        imageStore(u_glossy_direct, px, vec4(0.0));
+        return;
+    }
+#endif
     vec4 glossy = u_glossy_enabled ? texelFetch(u_glossy, px, 0) : vec4(0.0);
     bool has_glossy = max(glossy.r, max(glossy.g, glossy.b)) > 0.0;
     vec4 spec = texelFetch(u_specular, px, 0);
