@@ -11,6 +11,7 @@ from ..common import camera as cam
 from ..gl.bind import set_uniform, write_uniform
 from ..scene import Scene
 from .geometry import GeometryBuffers, draw_by_material
+from .shadows import box_rects
 
 GBUFFER_TARGETS = ("position", "normal", "albedo", "emission", "geo_normal", "glossy", "specular")
 
@@ -65,18 +66,12 @@ def render_gbuffer(ctx, programs, scene: Scene, geometry: GeometryBuffers, textu
                    tuple(float(c) for c in forward), camera.type == "ORTHO")
 
 
-def box_pixels(scene: Scene, width: int, height: int, box: np.ndarray, margin: int = 2) -> tuple:
+def box_pixels(scene: Scene, width: int, height: int, box: np.ndarray) -> tuple:
     """The G-buffer pixels (x0, y0, x1, y1; GL order, rows from the bottom, x1 and y1 excluded) that triangles
-    inside the world `box` (2, 3) can cover: its corners projected by the camera, grown by `margin` pixels; the
-    whole image where a corner lies behind the camera."""
+    inside the world `box` (2, 3) can cover: the box clipped to the camera's near plane and projected, grown by
+    shadows.MOVED_MARGIN pixels (shadows.box_rects, as a shadow map's redrawn rectangle); (0, 0, 0, 0) for none."""
     aspect = scene.pixel_aspect
     view_projection = cam.projection_matrix(scene.camera, width, height, aspect[0], aspect[1]) @ \
         cam.view_matrix(scene.camera)
-    corners = np.array([[box[i][0], box[j][1], box[k][2], 1.0] for i in (0, 1) for j in (0, 1) for k in (0, 1)])
-    clip = corners @ np.asarray(view_projection, np.float64).T
-    if np.any(clip[:, 3] <= 1e-9 * np.abs(clip[:, :3]).max(initial=1.0)):
-        return (0, 0, width, height)
-    pixel = (clip[:, :2] / clip[:, 3:] * 0.5 + 0.5) * (width, height)
-    lo = np.maximum(np.floor(pixel.min(axis=0)) - margin, 0).astype(int)
-    hi = np.minimum(np.ceil(pixel.max(axis=0)) + margin, (width, height)).astype(int)
-    return (int(lo[0]), int(lo[1]), int(max(hi[0], lo[0])), int(max(hi[1], lo[1])))
+    rect = box_rects(view_projection[None], box, [(0, 0, width, height)])[0]
+    return (0, 0, 0, 0) if rect is None else (rect[0], rect[1], rect[0] + rect[2], rect[1] + rect[3])

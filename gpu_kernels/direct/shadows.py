@@ -254,8 +254,13 @@ def moved_rects(views: list, box: np.ndarray, tiles: list) -> list:
     the RSM), which one view at a time cost 0.4 s."""
     if not views:
         return []
+    return box_rects(np.stack([np.asarray(v.view_projection, np.float64) for v in views]), box, tiles)
+
+
+def box_rects(view_projections: np.ndarray, box: np.ndarray, tiles: list) -> list:
+    """moved_rects for (V, 4, 4) world → clip matrices (the G-buffer's camera too: gbuffer.box_pixels)."""
     corners = np.array([[box[i][0], box[j][1], box[k][2], 1.0] for i in (0, 1) for j in (0, 1) for k in (0, 1)])
-    clip = np.einsum("ck,vjk->vcj", corners, np.stack([np.asarray(v.view_projection, np.float64) for v in views]))
+    clip = np.einsum("ck,vjk->vcj", corners, np.asarray(view_projections, np.float64))
     inside = clip[..., 2] + clip[..., 3]  # ≥ 0 in front of the near plane (z ≥ −w)
     a, b = BOX_EDGES[:, 0], BOX_EDGES[:, 1]
     da, db = inside[:, a], inside[:, b]
