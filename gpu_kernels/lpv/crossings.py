@@ -112,8 +112,14 @@ def mark_empty_space(coverage: np.ndarray) -> None:
     distance to the nearest cell that is not (empty_distance), so that a ray there may skip the cells within
     distance − 1, which are all empty too (Cohen and Sheffer 1994, "Proximity clouds": empty-space skipping by a
     distance map). Empty cells' w is free: plane cells' is negative, axis cells' holds their box_code."""
-    occupied = (coverage[..., 3] < 0) | (coverage[..., :3] > 0).any(axis=-1)
-    coverage[..., 3] = np.where(occupied, coverage[..., 3], empty_distance(occupied))
+    full = occupied(coverage)
+    coverage[..., 3] = np.where(full, coverage[..., 3], empty_distance(full))
+
+
+def occupied(coverage: np.ndarray) -> np.ndarray:
+    """Per cell of a coverage array (…, 4): whether lpv/gather.glsl finds a surface in it (a plane, or axis
+    coverage)."""
+    return (coverage[..., 3] < 0) | (coverage[..., :3] > 0).any(axis=-1)
 
 
 def empty_distance(occupied: np.ndarray, cap: int = SKIP_CELLS) -> np.ndarray:

@@ -46,6 +46,9 @@ class GeometryVolume:
     receiver_index: object = None  # r32i fine voxel texture: 8 × first receiver + mask of its axes (receivers.py),
     # where the grid is too large for light_volumes
 
+    # the crossing_layers arrays the coverage / layers / layers_far textures hold, kept on the host where a transfer
+    # update compares them with the next geometry's (lpv/transfer_update.changed_cells)
+    crossings: dict | None = None
     layers_far: object = None  # per LPV cell (lpv/crossings.py): the far layers where its surfaces form two
     # Material edits without a voxelisation (lpv/receivers.current_albedo): the materials surface_albedo was made
     # with (receivers.albedo_signature) and, per material index, the (2, R) share of each receiver side it covers

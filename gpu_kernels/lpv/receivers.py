@@ -111,6 +111,7 @@ def axis_volumes(ctx, programs, scene: Scene, geometry, textures, grids: list, p
         oriented = np.zeros((len(r["cells"]), 2, 4), np.float32)  # lpv/gather.glsl MODE_TRANSFER's Receivers
         oriented[:, 0, :3], oriented[:, 0, 3], oriented[:, 1, :3] = r["normals"], r["areas"], r["positions"]
         dense = light_volume_bytes(fine) <= LIGHT_VOLUME_BYTES
+        crossings = crossing_layers(area, normal, grid, surfaces)
         out.append(GeometryVolume(
             blocking, fine, None, None, None, surfaces=ssbo(ctx, records), surface_count=len(r["cells"]),
             cells=r["cells"], surface_normal=r["normals"], surface_area=r["areas"], surface_albedo=r["albedo"],
@@ -118,8 +119,8 @@ def axis_volumes(ctx, programs, scene: Scene, geometry, textures, grids: list, p
             receivers=ssbo(ctx, oriented),
             light_volumes=make_light_volumes(ctx, fine, r["cells"], r["axis"]) if dense else None,
             receiver_index=None if dense else _index_texture(ctx, r["cells"], r["axis"], fine),
-            voxels=regional.keep(arrays, scene, inputs), voxelised=share,
-            **volume_fields(ctx, crossing_layers(area, normal, grid, surfaces))))
+            voxels=regional.keep(arrays, scene, inputs), voxelised=share, crossings=crossings,
+            **volume_fields(ctx, crossings)))
     return out
 
 

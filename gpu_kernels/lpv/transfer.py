@@ -111,6 +111,7 @@ class Transfer:
     areas: np.ndarray = None
     updated: float = 1.0  # the share of T evaluated when it was made (1: all of it; less after an edit)
     rows: np.ndarray = None  # receiver_rows: what the next geometry's receivers are compared with
+    crossings: dict = None  # the visibility planes T was made with (lpv/crossings.py), likewise
 
     @property
     def nbytes(self) -> int:
@@ -147,7 +148,7 @@ def sorted_transfer(clusters: Clusters, matrix: np.ndarray, order: list, starts:
     if gv is None:
         return Transfer(clusters, matrix, order, starts, updated=updated)
     return Transfer(clusters, matrix, order, starts, grid, gv.cells.copy(), gv.axis.copy(), gv.surface_normal.copy(),
-                    gv.surface_area.copy(), updated, receiver_rows(gv) if rows is None else rows)
+                    gv.surface_area.copy(), updated, receiver_rows(gv) if rows is None else rows, gv.crossings)
 
 
 def receiver_rows(gv) -> np.ndarray:

@@ -155,11 +155,16 @@ def sphere_scene(subdivisions=3, radius=1.0, albedo=0.5, power=100.0, eye=(0.0, 
                  World(), Camera(cam_to_world, lens=18.0))
 
 
-def room_with_box(z, size=0.3):
-    """A 2 × 2 × 2 m room without a ceiling, lit by a point light, with a `size` m box standing `z` m above the
-    floor by the wall (the LPV's object-move tests)."""
-    quads = box_quads((-1, -1, 0), (1, 1, 2), 0, skip=((2, "hi"),)) + \
-        box_quads((0.8 - size, 0.8 - size, z), (0.8, 0.8, z + size), 1, inward=False)
+def room_with_box(z, size=0.3, height=None, turn=0.0):
+    """A 2 × 2 × 2 m room without a ceiling, lit by a point light, with a `size` m box (`height` m tall: `size`
+    where None) standing `z` m above the floor by the wall, turned `turn` degrees about the vertical (the LPV's
+    object-move tests)."""
+    height = size if height is None else height
+    box = box_quads((-0.5 * size, -0.5 * size, z), (0.5 * size, 0.5 * size, z + height), 1, inward=False)
+    c, s = np.cos(np.radians(turn)), np.sin(np.radians(turn))
+    turned = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    centre = np.array([0.8 - 0.5 * size, 0.8 - 0.5 * size, 0.0])
+    quads = box_quads((-1, -1, 0), (1, 1, 2), 0, skip=((2, "hi"),)) + [(q @ turned.T + centre, m) for q, m in box]
     bulb = np.eye(4)
     bulb[:3, 3] = (-0.4, 0.2, 1.4)
     return quad_scene(quads, [Material("floor", (0.7, 0.7, 0.7)), Material("box", (0.8, 0.3, 0.2))],

@@ -154,7 +154,7 @@ def test_the_transport_is_capped_only_where_its_reflection_is_impossible():
     c = cl.make_clusters(cells, normals, areas, FINE, budget=48)
     centres = (cells + 0.5) * FINE.cell
     gv = SimpleNamespace(cells=cells, axis=np.zeros(len(cells), np.int64), surface_normal=normals, surface_area=areas,
-                         positions=centres, bounds=(centres - 0.5 * FINE.cell, centres + 0.5 * FINE.cell))
+                         positions=centres, bounds=(centres - 0.5 * FINE.cell, centres + 0.5 * FINE.cell), crossings=None)
     weight = 0.8 * areas[:, None] * np.ones(3)
     # Light only on receiver sides that belong to a cluster (the others reflect nothing into M_ρ).
     raw = rng.uniform(0.5, 1.0, (2, c.count, len(cells))) * (c.side_cluster >= 0).T[:, None, :]

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Which (source, receiver) pairs of the cached transport a geometry edit can change through their visibility
-// (lpv/transfer.box_pairs): those whose segment passes through the box of the cells the edit changed. One bit per
+// (lpv/transfer.box_pairs): those whose segment passes through a box around the cells the edit changed. One bit per
 // pair, 32 receivers to a word: mask[(j − first) · words + w] bit b = receiver 32w + b, source j.
 layout(local_size_x = 64) in;
 #include "common/structs.glsl"
@@ -12,16 +12,21 @@ uniform int u_surface_count;
 uniform int u_words;
 uniform int u_vpl_first;
 uniform int u_vpl_count;
-uniform vec3 u_box_lo;
-uniform vec3 u_box_hi;
+#define MAX_BOXES 8   // lpv/transfer_update.MAX_BOXES
+uniform int u_box_count;
+uniform vec3 u_box_lo[MAX_BOXES];
+uniform vec3 u_box_hi[MAX_BOXES];
 
-bool crosses_box(vec3 a, vec3 b) {  // the segment a → b meets the box (slab test)
+bool crosses_box(vec3 a, vec3 b) {  // the segment a → b meets one of the boxes (slab test)
     vec3 d = b - a;
     vec3 inv = vec3(d.x != 0.0 ? 1.0 / d.x : 1e30, d.y != 0.0 ? 1.0 / d.y : 1e30, d.z != 0.0 ? 1.0 / d.z : 1e30);
-    vec3 t0 = (u_box_lo - a) * inv, t1 = (u_box_hi - a) * inv;
-    float enter = max(max(min(t0.x, t1.x), min(t0.y, t1.y)), min(t0.z, t1.z));
-    float leave = min(min(max(t0.x, t1.x), max(t0.y, t1.y)), max(t0.z, t1.z));
-    return enter <= leave && leave >= 0.0 && enter <= 1.0;
+    for (int k = 0; k < u_box_count; ++k) {
+        vec3 t0 = (u_box_lo[k] - a) * inv, t1 = (u_box_hi[k] - a) * inv;
+        float enter = max(max(min(t0.x, t1.x), min(t0.y, t1.y)), min(t0.z, t1.z));
+        float leave = min(min(max(t0.x, t1.x), max(t0.y, t1.y)), max(t0.z, t1.z));
+        if (enter <= leave && leave >= 0.0 && enter <= 1.0) return true;
+    }
+    return false;
 }
 
 void main() {
