@@ -22,11 +22,12 @@ from .clusters import Clusters, make_clusters
 from .transfer import cluster_order, dispatch_in_runs, kernel_program, receiver_rows, sorted_transfer
 
 PAIRS_PER_DISPATCH = 1 << 20  # pairs evaluated per dispatch and listed at a time: 8 MiB read back, 16384 groups
-# Loop iterations per box_pairs invocation: it tests 32 receivers against each box for each source of its dispatch,
-# and llvmpipe ends an invocation's loops after 65535 iterations in all (lpv/gather.vpls_per_dispatch), silently:
-# 1024 sources against eight boxes listed only half the pairs that cross them.
-MASK_ITERATIONS = 32768
-MAX_BOXES = 8  # boxes around the changed cells (changed_boxes), as lpv/box_pairs.glsl declares
+# box_pairs' invocations per dispatch: one per source and word of 32 receivers (the most work groups of 64 a
+# dispatch may have). Looping over a run of sources in each invocation instead (one per word) kept only a few work
+# groups busy and ran into llvmpipe's cap on an invocation's loop iterations (65535 in all, then it silently stops:
+# 1024 sources against eight boxes listed half the pairs that cross them).
+MASK_INVOCATIONS = 65535 * 64
+MAX_BOXES = 8  # boxes around the changed cells (changed_boxes); lpv/box_pairs.glsl holds one more
 # What an edit leaves the same, to float rounding: a receiver's or cluster's row is kept where no entry moved by more
 # than these (normals: unit; areas: × the fine voxel's face; positions: × its edge). Moving an object re-derives its
 # triangles in world space, and the float32 arithmetic of its voxels' areas, normals and centroids changes in the
@@ -121,13 +122,14 @@ def box_pairs(ctx, programs, gv, clusters: Clusters, boxes: np.ndarray) -> np.nd
     gv.receivers.bind_to_storage_buffer(10)
     set_uniform(prog, "u_surface_count", r)
     set_uniform(prog, "u_words", words)
+    boxes = np.concatenate([[[boxes[:, 0].min(axis=0), boxes[:, 1].max(axis=0)]], boxes])  # the box around them first
     set_uniform(prog, "u_box_count", len(boxes))
-    padded = np.zeros((2, MAX_BOXES, 3))
-    padded[:, :len(boxes)] = np.asarray(boxes).transpose(1, 0, 2)
+    padded = np.zeros((2, MAX_BOXES + 1, 3))
+    padded[:, :len(boxes)] = boxes.transpose(1, 0, 2)
     set_uniform(prog, "u_box_lo", [tuple(float(v) for v in corner) for corner in padded[0]])
     set_uniform(prog, "u_box_hi", [tuple(float(v) for v in corner) for corner in padded[1]])
-    per_run = max(1, MASK_ITERATIONS // (32 * (len(boxes) + 1)))
-    for first, count, data in dispatch_in_runs(ctx, prog, c, per_run, words, 4 * words):
+    per_run = max(1, MASK_INVOCATIONS // words)
+    for first, count, data in dispatch_in_runs(ctx, prog, c, per_run, min(per_run, c) * words, 4 * words):
         bits = np.frombuffer(data, np.uint32).reshape(count, words)
         out[first:first + count] = np.unpackbits(bits.view(np.uint8), axis=1, bitorder="little")[:, :r]
     sources.release()

@@ -39,10 +39,11 @@ def _slab_test(a: np.ndarray, b: np.ndarray, box: np.ndarray) -> np.ndarray:
 
 
 def test_the_pairs_listed_are_those_whose_segment_crosses_a_box(gl):
-    """lpv/box_pairs.glsl against a float64 slab test, with the most boxes and more sources than one dispatch
-    holds: its loops are bounded by MASK_ITERATIONS (llvmpipe silently ends an invocation's loops after 65535
-    iterations; with 1024 sources a dispatch and eight boxes it listed half the pairs). Random segments in a 2 m
-    cube; a segment that grazes a box's face may come out either way in float32 (≤ 0.1% of the crossing pairs)."""
+    """lpv/box_pairs.glsl against a float64 slab test, with the most boxes and 700 sources (when each invocation
+    looped over a run of 1024 sources, eight boxes took it past llvmpipe's cap on loop iterations, which silently
+    ended the loops: half the crossing pairs went unlisted). Random segments in a 2 m cube; a segment that grazes a
+    box's face may come out either way in float32 (≤ 0.1% of the crossing pairs)."""
+
     from types import SimpleNamespace
 
     from bounce_gi.gpu_kernels.gl.bind import ssbo

@@ -12,33 +12,36 @@ uniform int u_surface_count;
 uniform int u_words;
 uniform int u_vpl_first;
 uniform int u_vpl_count;
-#define MAX_BOXES 8   // lpv/transfer_update.MAX_BOXES
+#define MAX_BOXES 9   // lpv/transfer_update.MAX_BOXES + 1
 uniform int u_box_count;
-uniform vec3 u_box_lo[MAX_BOXES];
+uniform vec3 u_box_lo[MAX_BOXES];   // [0]: the box around all the others, tested first (most pairs miss it)
 uniform vec3 u_box_hi[MAX_BOXES];
 
-bool crosses_box(vec3 a, vec3 b) {  // the segment a → b meets one of the boxes (slab test)
+bool slab(vec3 a, vec3 inv, vec3 lo, vec3 hi) {  // the segment a → a + 1/inv meets the box lo..hi
+    vec3 t0 = (lo - a) * inv, t1 = (hi - a) * inv;
+    float enter = max(max(min(t0.x, t1.x), min(t0.y, t1.y)), min(t0.z, t1.z));
+    float leave = min(min(max(t0.x, t1.x), max(t0.y, t1.y)), max(t0.z, t1.z));
+    return enter <= leave && leave >= 0.0 && enter <= 1.0;
+}
+
+bool crosses_box(vec3 a, vec3 b) {  // the segment a → b meets one of the boxes 1 … count − 1
     vec3 d = b - a;
     vec3 inv = vec3(d.x != 0.0 ? 1.0 / d.x : 1e30, d.y != 0.0 ? 1.0 / d.y : 1e30, d.z != 0.0 ? 1.0 / d.z : 1e30);
-    for (int k = 0; k < u_box_count; ++k) {
-        vec3 t0 = (u_box_lo[k] - a) * inv, t1 = (u_box_hi[k] - a) * inv;
-        float enter = max(max(min(t0.x, t1.x), min(t0.y, t1.y)), min(t0.z, t1.z));
-        float leave = min(min(max(t0.x, t1.x), max(t0.y, t1.y)), max(t0.z, t1.z));
-        if (enter <= leave && leave >= 0.0 && enter <= 1.0) return true;
-    }
+    if (!slab(a, inv, u_box_lo[0], u_box_hi[0])) return false;
+    for (int k = 1; k < u_box_count; ++k)
+        if (slab(a, inv, u_box_lo[k], u_box_hi[k])) return true;
     return false;
 }
 
-void main() {
-    int w = int(gl_GlobalInvocationID.x);
-    if (w >= u_words) return;
-    for (int j = u_vpl_first; j < u_vpl_first + u_vpl_count; ++j) {
-        vec3 a = vpls[j].position.xyz;
-        uint bits = 0u;
-        for (int b = 0; b < 32; ++b) {
-            int i = 32 * w + b;
-            if (i < u_surface_count && crosses_box(a, receivers[2 * i + 1].xyz)) bits |= 1u << uint(b);
-        }
-        mask[(j - u_vpl_first) * u_words + w] = bits;
+void main() {  // one invocation per (source, word of 32 receivers)
+    int id = int(gl_GlobalInvocationID.x);
+    if (id >= u_vpl_count * u_words) return;
+    int j = u_vpl_first + id / u_words, w = id % u_words;
+    vec3 a = vpls[j].position.xyz;
+    uint bits = 0u;
+    for (int b = 0; b < 32; ++b) {
+        int i = 32 * w + b;
+        if (i < u_surface_count && crosses_box(a, receivers[2 * i + 1].xyz)) bits |= 1u << uint(b);
     }
+    mask[id] = bits;
 }
