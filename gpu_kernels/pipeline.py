@@ -14,7 +14,8 @@ Passes and their inputs (a pass re-runs only when one of its inputs changed — 
                     meshes' lights and the sky's views: common/lights.static_lights; an object move keeps them)
     gbuffer       ← geometry, materials, camera, resolution
     sky_visibility← geometry, shading, camera, the sky's shadow views (its visible shares: a world colour edit or
-                    another light's move keeps them)
+                    another light's move keeps them; after an object's move, each pixel redoes only the tests that read
+                    a redrawn texel: direct/sky.SkyUpdate)
     direct_light  ← geometry, shading, camera, shadow_maps, sky_visibility (scene.material_keys: a dielectric's
                     base colour edit keeps both); after an object's move, the pixels it cannot change keep their light
                     (direct/lighting.Relight)
@@ -38,7 +39,7 @@ from .common import lights as lb
 from .compose import compose_passes
 from .direct import gbuffer as gb
 from .direct import geometry as geo
-from .direct import lighting, shadows as sh
+from .direct import lighting, shadows as sh, sky
 from .gl.bind import read_texture
 from .gl.pass_cache import PassCache
 from .gl.programs import ProgramCache
@@ -240,39 +241,60 @@ class Pipeline:
         """The direct_light pass, and before it the sky light's visibility, kept apart (sky_visibility): it depends
         on the G-buffer and the sky's own shadow maps, not on any light's colour nor on the other lights, so a world
         or light colour edit and another light's move skip it. `camera`: the G-buffer is the camera's (an object's
-        move then re-lights only the pixels it can change: _relight)."""
-        sky = self.cache.run("sky_visibility", (frame.keys["direct"][0], sh.sky_key(frame.shadows)),
-                             lambda: lighting.render_sky_visibility(self.ctx, self.programs, frame.gbuffer,
-                                                                    frame.shadows, material_lut))
+        move then re-lights only the pixels it can change: _relight, _sky_update)."""
+        maps, scene = frame.shadows.maps, frame.scene
+        made_from = (maps.serial, maps.generation, (scene.positions, scene.normals, scene.uvs, scene.material_index),
+                     frame.keys["gbuffer"])
+        k_sky = (frame.keys["direct"][0], sh.sky_key(frame.shadows))
+
+        def sky_visibility():
+            update = self._sky_update(frame, k_sky) if camera else None
+            out = sky.render_sky_visibility(self.ctx, self.programs, frame.gbuffer, frame.shadows, material_lut,
+                                            update)
+            if out is not None:
+                out.made_from = made_from
+            return out
+        shares = self.cache.run("sky_visibility", k_sky, sky_visibility)
         # Each group of lights keeps its images while its lights do not change (direct/lighting.light_groups): from
         # the kept output of the same G-buffer and shadow settings, a light's edit re-lights that light alone.
         prior = self.cache.prior("direct_light", lambda k: k[0] == frame.keys["direct"][0]
                                  and k[1][4] == frame.keys["shadow"][4])
         relight = self._relight(frame) if camera and prior is None else None
-        maps, scene = frame.shadows.maps, frame.scene
-        made_from = (maps.serial, maps.generation, (scene.positions, scene.normals, scene.uvs, scene.material_index),
-                     frame.keys["gbuffer"])
         return self.cache.run("direct_light", frame.keys["direct"], lambda: {**lighting.render_direct_light(
-            self.ctx, self.programs, frame.gbuffer, frame.shadows, material_lut, sky, prior, relight),
-            "made_from": made_from})
+            self.ctx, self.programs, frame.gbuffer, frame.shadows, material_lut,
+            None if shares is None else shares.texture, prior, relight), "made_from": made_from})
 
-    def _relight(self, frame) -> lighting.Relight | None:
-        """After an object's move, the kept Diffuse Direct of the same camera, materials and shadow settings, lit
-        from the same depth atlas one update ago, with where the move can change it (lighting.Relight); else None."""
-        keys, maps = frame.keys, frame.shadows.maps
-        kept = self.cache.prior("direct_light", lambda k: k[0][1:] == keys["direct"][0][1:]
-                                and k[1][4] == keys["shadow"][4])
-        if kept is None or maps.redrawn is None:
+    def _moved_since(self, frame, made_from) -> tuple | None:
+        """(the G-buffer rectangle the moved triangles can cover, the depth atlas's last redraw) where an output
+        made from `made_from` (its depth atlas's serial and generation, triangles and G-buffer key) was made one
+        update of the same atlas ago, for the same camera; else None."""
+        keys, maps, scene = frame.keys, frame.shadows.maps, frame.scene
+        serial, generation, surfaces, gbuffer_key = made_from
+        if maps.redrawn is None or (serial, generation + 1) != (maps.serial, maps.generation) \
+                or gbuffer_key[1:] != keys["gbuffer"][1:]:
             return None
-        serial, generation, surfaces, gbuffer_key = kept["made_from"]
-        if (serial, generation + 1) != (maps.serial, maps.generation) or gbuffer_key[1:] != keys["gbuffer"][1:]:
-            return None
-        scene = frame.scene
         box = sh.moved_box(surfaces, (scene.positions, scene.normals, scene.uvs, scene.material_index))
         if box is False:
             return None
         w, h = frame.gbuffer.size
-        return lighting.Relight(kept, (0, 0, 0, 0) if box is None else gb.box_pixels(scene, w, h, box), maps.redrawn)
+        return (0, 0, 0, 0) if box is None else gb.box_pixels(scene, w, h, box), maps.redrawn
+
+    def _relight(self, frame) -> lighting.Relight | None:
+        """After an object's move, the kept Diffuse Direct of the same camera, materials and shadow settings, lit
+        from the same depth atlas one update ago, with where the move can change it (lighting.Relight); else None."""
+        keys = frame.keys
+        kept = self.cache.prior("direct_light", lambda k: k[0][1:] == keys["direct"][0][1:]
+                                and k[1][4] == keys["shadow"][4])
+        moved = None if kept is None else self._moved_since(frame, kept["made_from"])
+        return None if moved is None else lighting.Relight(kept, *moved)
+
+    def _sky_update(self, frame, k_sky) -> sky.SkyUpdate | None:
+        """After an object's move, the kept sky shares of the same camera, shading and sky, made from the same depth
+        atlas one update ago, and what the move redrew of the sky's maps (sky.SkyUpdate); else None."""
+        kept = self.cache.prior("sky_visibility", lambda k: k[0][1:] == k_sky[0][1:] and k[1] == k_sky[1])
+        moved = None if kept is None else self._moved_since(frame, kept.made_from)
+        table = None if moved is None else sky.update_table(frame.shadows)
+        return None if table is None else sky.SkyUpdate(kept, moved[0], table, frame.shadows.maps.overwritten.buffer)
 
     @staticmethod
     def _method_output(frame):

@@ -60,7 +60,7 @@ def render_direct_light(ctx, programs, gbuffer: GBuffer, shadows: ShadowAtlas, m
     """{"diffuse": Diffuse Direct (irradiance/π), "glossy": Glossy Direct} for every G-buffer pixel, (H, W, 3)
     float32 as gl/bind.read_texture gives a texture. `material_lut`: the materials' Principled table
     (direct/geometry.MaterialTextures.lut); None for G-buffers with no camera (the surface atlas), whose Glossy
-    Direct is 0. `sky`: the sky light's shares from render_sky_visibility (None: computed here). The lights are lit
+    Direct is 0. `sky`: the sky light's shares (direct/sky.render_sky_visibility's texture; None: computed here). The lights are lit
     by groups (light_groups) and summed; "groups" keeps each group's images by key, and a group whose key `prior`
     (an earlier output for the same G-buffer, shadow settings and material table) holds is not lit again ("relit":
     the groups that were); with `relight` instead, an unchanged group is lit again where an object's move can
@@ -78,7 +78,7 @@ def render_direct_light(ctx, programs, gbuffer: GBuffer, shadows: ShadowAtlas, m
         unit_ssbo = ssbo(ctx, unit_records)
         for g in todo:
             # The inputs again for each group: the previous group's read-back re-bound texture units.
-            unit = _bind_inputs(prog, gbuffer, shadows, material_lut)
+            unit = bind_inputs(prog, gbuffer, shadows, material_lut)
             if sky is not None:
                 bind_samplers(prog, "u_sky_shares", [sky], unit)
             set_uniform(prog, "u_sky_cached", sky is not None)
@@ -157,43 +157,7 @@ def _render_group(ctx, prog, gbuffer: GBuffer, lights: list, textures: list, mas
     return tuple(np.where(lit, image[..., :3], old) for image, old in zip(new, mask.prior))
 
 
-def render_sky_visibility(ctx, programs, gbuffer: GBuffer, shadows: ShadowAtlas, material_lut=None):
-    """RGBA32F per G-buffer pixel: the sky light's visible shares (direct/light.glsl MODE_SKY: x of its cosine
-    weight, y of the glossy lobe's, z its penumbra's half-width in metres), averaged over that penumbra on the
-    pixel's own surface (direct/sky_filter.glsl), or None where the scene has no sky light. They depend on the
-    G-buffer and the sky's shadow maps, not on the world's colour: the pipeline keeps them across world and light
-    edits, and the Diffuse Direct pass reads them instead of testing the sky's hundreds of directions again."""
-    if not any(int(t) == lb.LIGHT_SKY for t in shadows.buffers.lights["color_type"][:, 3]):
-        return None
-    w, h = gbuffer.size
-    out = ctx.texture((w, h), 4, dtype="f4")
-    prog = programs.compute("direct/light.glsl", {"MODE_SKY": None})
-    out.bind_to_image(2, read=False, write=True)
-    _bind_inputs(prog, gbuffer, shadows, material_lut)
-    dispatch(prog, (w, h), local=8)
-    return filter_sky_shares(ctx, programs, gbuffer, out)
-
-
-def filter_sky_shares(ctx, programs, gbuffer: GBuffer, shares):
-    """The sky's shares averaged over each pixel's penumbra on its own surface, one image axis at a time
-    (direct/sky_filter.glsl); releases `shares`."""
-    w, h = gbuffer.size
-    prog = programs.compute("direct/sky_filter.glsl")
-    unit = bind_samplers(prog, "u_position", [gbuffer.textures["position"]], 0)
-    unit = bind_samplers(prog, "u_geo_normal", [gbuffer.textures["geo_normal"]], unit)
-    set_uniform(prog, "u_size", (w, h))
-    for axis in ((1, 0), (0, 1)):
-        out = ctx.texture((w, h), 4, dtype="f4")
-        bind_samplers(prog, "u_shares", [shares], unit)
-        out.bind_to_image(0, read=False, write=True)
-        set_uniform(prog, "u_axis", axis)
-        dispatch(prog, (w, h), local=8)
-        shares.release()
-        shares = out
-    return shares
-
-
-def _bind_inputs(prog, gbuffer: GBuffer, shadows: ShadowAtlas, material_lut) -> int:
+def bind_inputs(prog, gbuffer: GBuffer, shadows: ShadowAtlas, material_lut) -> int:
     """The G-buffer, the material table and the lights for direct/light.glsl; returns the next free texture unit."""
     unit = 0
     for name in ("position", "normal", "geo_normal", "glossy", "specular"):

@@ -10,7 +10,7 @@ import numpy as np
 
 from ..common import atlas
 from ..common import lights as lb
-from ..gl.bind import set_uniform, ssbo, write_uniform
+from ..gl.bind import dispatch, set_uniform, ssbo, write_uniform
 from ..scene import Scene, hash_parts
 from .geometry import GeometryBuffers
 
@@ -72,8 +72,11 @@ def render_shadow_atlas(ctx, programs, scene: Scene, geometry: GeometryBuffers,
 
     rows = view_rows(buffers.views)
 
+    sky = frozenset(i for i, light in enumerate(buffers.view_lights)
+                    if int(buffers.lights[light]["color_type"][3]) == lb.LIGHT_SKY)
+
     def render(prior=None):
-        return render_depth(ctx, programs, geometry, buffers.views, tiles, size, prior, rows, scene.positions)
+        return render_depth(ctx, programs, geometry, buffers.views, tiles, size, prior, rows, scene.positions, sky)
 
     key = depth_key(rows, tiles, size)
     maps = render() if depth_pass is None else depth_pass(key, render)
@@ -139,9 +142,54 @@ class DepthAtlas:
     serial: int = field(default_factory=itertools.count().__next__)
     generation: int = 0
     redrawn: list = None
+    overwritten: KeptTexels = None  # the texels the last update's rectangles overwrote, in the views asked for
 
     def release(self):
         self.texture.release()
+        if self.overwritten is not None:
+            self.overwritten.release()
+
+
+@dataclass
+class KeptTexels:
+    """Depths an update of the atlas overwrote (keep_texels): per view index, (x, y, w, h, first) — its redrawn
+    rectangle in atlas texels and where its texels start in `buffer` (float32, row by row)."""
+    buffer: object
+    rects: dict
+
+    def release(self):
+        self.buffer.release()
+
+
+# The most texels an update keeps (64 MiB): a move whose rectangles hold more (an object filling the sky's maps)
+# keeps none, and what would have read them is made anew.
+MAX_KEPT_TEXELS = 1 << 24
+
+
+def keep_texels(ctx, programs, depth, rects: list) -> KeptTexels | None:
+    """The depths of `depth` inside `rects` ((view, (x, y, w, h)) pairs), copied before they are drawn over
+    (direct/keep_texels.glsl); None where there are none or more than MAX_KEPT_TEXELS."""
+    import moderngl
+
+    total = sum(w * h for _, (_, _, w, h) in rects)
+    if not rects or total > MAX_KEPT_TEXELS:
+        return None
+    firsts = np.concatenate([[0], np.cumsum([w * h for _, (_, _, w, h) in rects])[:-1]]).astype(np.int64)
+    table = np.array([(x, y, w, h, int(f), 0, 0, 0) for (_, (x, y, w, h)), f in zip(rects, firsts)], np.int32)
+    out = ctx.buffer(reserve=4 * total)
+    buffers = [ssbo(ctx, table)]
+    raw = ctx.sampler(repeat_x=False, repeat_y=False, filter=(moderngl.NEAREST, moderngl.NEAREST), compare_func="",
+                      texture=depth)
+    prog = programs.compute("direct/keep_texels.glsl")
+    raw.use(location=0)
+    set_uniform(prog, "u_depth", 0)
+    buffers[0].bind_to_storage_buffer(0)
+    out.bind_to_storage_buffer(1)
+    dispatch(prog, (max(w for _, (_, _, w, _) in rects), max(h for _, (_, _, _, h) in rects), len(rects)))
+    ctx.memory_barrier()
+    raw.release()
+    buffers[0].release()
+    return KeptTexels(out, {v: (x, y, w, h, int(f)) for (v, (x, y, w, h)), f in zip(rects, firsts)})
 
 
 def view_rows(views: list) -> np.ndarray:
@@ -173,12 +221,14 @@ def redraw_plan(prior, views: list, tiles: list, size: tuple, rows: np.ndarray, 
 
 def render_depth(ctx, programs, geometry: GeometryBuffers, views: list, tiles: list, size: tuple,
                  prior: DepthAtlas | None = None, rows: np.ndarray | None = None,
-                 positions: np.ndarray | None = None) -> DepthAtlas:
+                 positions: np.ndarray | None = None, keep: frozenset = frozenset()) -> DepthAtlas:
     """The depth atlas: every view drawn into its tile (direct/shadow_depth.glsl). With `prior` (an atlas tiled
     alike) only what changed is drawn again, into `prior`, which is returned updated: whoever held it sees the new
     maps (the pass cache, whose entry it then is) — the tiles whose view changed (a light's move redraws that light's
     maps), and where the scene's triangles (`positions`) moved since `prior` was drawn, in every other tile the
-    rectangle the moved triangles' box covers (moved_rects). `rows`: view_rows(views)."""
+    rectangle the moved triangles' box covers (moved_rects). `rows`: view_rows(views). The depths the rectangles of
+    the views in `keep` overwrite are kept (DepthAtlas.overwritten: the sky's, whose tests direct/sky.py takes out
+    and adds back)."""
     import moderngl
 
     rows = view_rows(views) if rows is None else rows
@@ -192,6 +242,10 @@ def render_depth(ctx, programs, geometry: GeometryBuffers, views: list, tiles: l
         depth.filter = (moderngl.LINEAR, moderngl.LINEAR)
         depth.repeat_x = depth.repeat_y = False
     draws = [(i, None) for i in range(len(views))] if plan is None else plan
+    if plan is not None:
+        if prior.overwritten is not None:
+            prior.overwritten.release()
+        prior.overwritten = keep_texels(ctx, programs, depth, [(i, r) for i, r in draws if r is not None and i in keep])
     if draws:
         fbo = ctx.framebuffer(depth_attachment=depth)
         fbo.use()

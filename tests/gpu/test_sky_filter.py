@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""The sky's penumbra filter (direct/sky_filter.glsl via direct/lighting.filter_sky_shares), driven with a G-buffer
+"""The sky's penumbra filter (direct/sky_filter.glsl via direct/sky.filter_sky_shares), driven with a G-buffer
 we choose: a floor beside a wall, 2 cm per pixel. A step in the floor's sky share (an opening's edge seen through
 one direction) must come back as the box average over each pixel's penumbra half-width of the floor's own pixels
 only — exactly, in float32 — and the wall beside it, whose share differs, must neither take nor give any."""
@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from bounce_gi.gpu_kernels.direct.gbuffer import GBuffer
-from bounce_gi.gpu_kernels.direct.lighting import filter_sky_shares
+from bounce_gi.gpu_kernels.direct.sky import filter_sky_shares
 
 W, H = 64, 16
 FLOOR = 32          # columns 0..31: the floor (z = 0, normal +z); 32..63: a wall (x = 0.64 m, normal −x)

@@ -28,6 +28,32 @@ vec3 biased_point(ShadowView v, vec3 p, vec3 geo_n, vec3 to_light, float max_slo
     return p + geo_n * texel_world * (OFFSET_TEXELS + 2.0 * min(sin_l / max(cos_l, 0.05), max_slope));
 }
 
+// Where the test of view `view_index` at p reads: the atlas uv of p biased (biased_point) and its depth as the
+// shadow pass stored it — rasterised z (ortho) or radial distance / far (perspective); false where p lies behind the
+// view's eye or outside its map (unshadowed).
+bool view_uv_depth_biased(ShadowView v, vec3 p, vec3 geo_n, vec3 to_light, float max_slope, out vec2 atlas_uv,
+                          out float depth) {
+    bool ortho = v.origin.w > 0.5;
+    vec3 q = biased_point(v, p, geo_n, to_light, max_slope);
+    vec4 clip = v.view_projection * vec4(q, 1.0);
+    vec3 ndc = clip.xyz / clip.w;
+    atlas_uv = vec2(0.0);
+    depth = 0.0;
+    if (clip.w <= 0.0) return false;
+    vec2 uv = ndc.xy * 0.5 + 0.5;
+    if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return false;  // outside: unshadowed
+    depth = ortho ? ndc.z * 0.5 + 0.5 : length(q - v.origin.xyz) / v.info.z;
+    atlas_uv = v.tile.xy + uv * v.tile.zw;
+    return true;
+}
+
+// With PCF radius 0 (the sky's maps) a test reads the four texels a gather at this point reads: a texel short of
+// the tile's far edges, where a gather would read the next tile's first texels.
+vec2 gather_point(ShadowView v, vec2 atlas_uv) {
+    vec2 hi = v.tile.xy + v.tile.zw - 0.5 * u_atlas_texel;
+    return clamp(atlas_uv, v.tile.xy + 0.5 * u_atlas_texel, hi - 0.5 * u_atlas_texel);
+}
+
 // max_slope caps the slope-scaled part of the offset (MAX_SLOPE for a light's own maps; 0 for the sky's many directions: a
 // grazing one pushed far off the surface would test a point beyond a thin wall, and acne in a few of them is
 // averaged away).
@@ -36,18 +62,11 @@ vec3 biased_point(ShadowView v, vec3 p, vec3 geo_n, vec3 to_light, float max_slo
 float view_test(int view_index, vec3 p, vec3 geo_n, vec3 to_light, float max_slope, out float gap) {
     gap = 0.0;
     ShadowView v = shadow_views[view_index];
-    bool ortho = v.origin.w > 0.5;
-    vec3 q = biased_point(v, p, geo_n, to_light, max_slope);
-    vec4 clip = v.view_projection * vec4(q, 1.0);
-    vec3 ndc = clip.xyz / clip.w;
-    if (clip.w <= 0.0) return 1.0;
-    vec2 uv = ndc.xy * 0.5 + 0.5;
-    if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return 1.0;  // outside: unshadowed
-    // Same depth the shadow pass stored: rasterised z (ortho) or radial distance / far (perspective).
-    float depth = ortho ? ndc.z * 0.5 + 0.5 : length(q - v.origin.xyz) / v.info.z;
+    vec2 atlas_uv;
+    float depth;
+    if (!view_uv_depth_biased(v, p, geo_n, to_light, max_slope, atlas_uv, depth)) return 1.0;
     vec2 lo = v.tile.xy + 0.5 * u_atlas_texel;
     vec2 hi = v.tile.xy + v.tile.zw - 0.5 * u_atlas_texel;
-    vec2 atlas_uv = v.tile.xy + uv * v.tile.zw;
     // PCF: a (2r+1)² grid of bilinear hardware comparisons.
     int r = int(v.info.y);
     // PCF radius 0 (the sky's maps): shadowed if any of the four texels around p is — a wall meeting the floor
@@ -56,8 +75,7 @@ float view_test(int view_index, vec3 p, vec3 geo_n, vec3 to_light, float max_slo
     // texel at all: only the dilation keeps the sky out along a zero-thickness wall parallel to a direction). It
     // darkens each direction's visible region by a texel on every side: a few percent under a skylight.
     if (r == 0) {  // the stored depths compared here as the atlas's "<=" comparison would
-        // a texel short of the far edges: a gather there would read the next tile's first texels
-        vec4 z = textureGather(u_shadow_depth, clamp(atlas_uv, lo, hi - 0.5 * u_atlas_texel), 0);
+        vec4 z = textureGather(u_shadow_depth, gather_point(v, atlas_uv), 0);
         gap = depth - min(min(z.x, z.y), min(z.z, z.w));
         return gap <= 0.0 ? 1.0 : 0.0;
     }

@@ -32,7 +32,13 @@ layout(std430, binding = 9) readonly buffer GroupLights { int group_lights[]; };
 uniform bool u_sky_cached;
 uniform sampler2D u_sky_shares;
 #if defined(MODE_SKY)
-layout(rgba32f, binding = 2) uniform writeonly image2D u_sky_out;
+layout(rgba32f, binding = 2) uniform writeonly image2D u_sky_out;     // shares (direct/sky.glsl sky_result)
+layout(rgba32f, binding = 3) uniform writeonly image2D u_sky_sums;    // SkySums.weights
+layout(rgba32f, binding = 4) uniform writeonly image2D u_sky_blocked; // SkySums.penumbra
+// After an object's move (direct/sky.py): the sums of one update ago, updated outside u_moved_pixels
+uniform bool u_sky_update;
+uniform sampler2D u_sky_sums_prior;
+uniform sampler2D u_sky_blocked_prior;
 #endif
 // After an object's move (direct/lighting.Relight) only the pixels it can change are lit again: those inside
 // u_moved_pixels (x0, y0, x1, y1: where the moved triangles can cover the G-buffer) and those whose shadow tests can
@@ -95,48 +101,22 @@ bool unchanged(ivec2 px, vec3 p, vec3 geo_n) {
     return true;
 }
 
-// The sky light's visible shares at p, from one shadow test per direction (direct/eval.glsl sky_direction): x of
-// the cosine weight (irradiance), y (when `lobe_seen`) of the glossy lobe's (direct/ggx.glsl sky_lobe_weight). The
-// lobe's α² is widened by SKY_LOBE_SPREAD / K so that a mirror still averages its few nearest directions rather
-// than one.
-#define SKY_LOBE_SPREAD 2.0
-vec2 sky_shares(GpuLight L, vec3 p, vec3 n, vec3 geo_n, GlossyLobe lobe, vec3 v, bool lobe_seen,
-                out float penumbra) {
-    int samples = int(L.params.z);
-    penumbra = 0.0;
-    if (samples == 0) return vec2(1.0);
-    float blocked = 0.0;
-    float a2 = lobe.alpha * lobe.alpha + SKY_LOBE_SPREAD / float(samples);
-    GlossyFresnel fresnel = glossy_fresnel_rows(u_material_lut, lobe.material, lobe.mu, lobe.base);
-    vec2 wsum = vec2(0.0), vsum = vec2(0.0);
-    for (int k = 0; k < samples; k += max(u_sky_stride, 1)) {
-        vec3 d;
-        if (!sky_direction(L, k, geo_n, d)) continue;
-        vec2 w = vec2(max(dot(n, d), 0.0), lobe_seen ? sky_lobe_weight(lobe, fresnel, a2, n, v, d) : 0.0);
-        if (max(w.x, w.y) <= 0.0) continue;
-        wsum += w;
-        float gap;   // in the map's stored depth
-        float seen = view_test(int(L.params.y) + k, p, geo_n, d, 0.0, gap);
-        vsum += w * seen;
-        if (gap > 0.0 && w.x > 0.0) {
-            penumbra += w.x / (gap * ortho_depth_scale(int(L.params.y) + k));
-            blocked += w.x;
-        }
-    }
-    // A direction's cone (half-width √(4π/K)/2) at the blockers' distance: the width over which each of its hard
-    // shadows' edges should fade (direct/sky_filter.glsl). Their harmonic mean, so that a receiver beside a wall
-    // (many blockers near) keeps the contact shadow the wall casts rather than the far blockers' wide fade.
-    penumbra = penumbra > 0.0 ? 0.5 * sqrt(4.0 * PI / float(samples)) * blocked / penumbra : 0.0;
-    return vec2(wsum.x > 0.0 ? vsum.x / wsum.x : 0.0, wsum.y > 0.0 ? vsum.y / wsum.y : 0.0);
-}
+#include "direct/sky.glsl"
 
 void main() {
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
-    if (any(greaterThanEqual(px, u_size))) return;
-    vec4 pos = texelFetch(u_position, px, 0);
+    bool inside = all(lessThan(px, u_size));
+    vec4 pos = inside ? texelFetch(u_position, px, 0) : vec4(0.0);
+#if defined(MODE_SKY)
+    bool moved = all(greaterThanEqual(px, u_moved_pixels.xy)) && all(lessThan(px, u_moved_pixels.zw));
+    bool updated = u_sky_update && pos.w >= 0.5 && !moved;
+#endif
+    if (!inside) return;
     if (pos.w < 0.5) {
 #if defined(MODE_SKY)
         imageStore(u_sky_out, px, vec4(0.0));
+        imageStore(u_sky_sums, px, vec4(0.0));
+        imageStore(u_sky_blocked, px, vec4(0.0));
 #else
         imageStore(u_diffuse_direct, px, vec4(0.0, 0.0, 0.0, 1.0));
         imageStore(u_glossy_direct, px, vec4(0.0, 0.0, 0.0, 1.0));
@@ -159,12 +139,19 @@ void main() {
     GlossyLobe lobe = GlossyLobe(glossy.w * glossy.w, int(spec.w + 0.5), dot(n, v), spec.rgb);
     bool lobe_seen = has_glossy && lobe.mu > 0.0;
 #if defined(MODE_SKY)
-    vec2 sky = vec2(0.0);
-    float penumbra = 0.0;
+    SkySums sums = SkySums(vec4(0.0), vec2(0.0));
+    vec3 sky = vec3(0.0);
     for (int i = 0; i < u_light_count; ++i)
-        if (int(lights[i].color_type.w) == LIGHT_SKY)
-            sky = sky_shares(lights[i], pos.xyz, n, geo_n, lobe, v, lobe_seen, penumbra);
-    imageStore(u_sky_out, px, vec4(sky, penumbra, 0.0));
+        if (int(lights[i].color_type.w) == LIGHT_SKY) {
+            sums = updated
+                ? sky_sums_update(SkySums(texelFetch(u_sky_sums_prior, px, 0), texelFetch(u_sky_blocked_prior, px,
+                                  0).xy), lights[i], pos.xyz, n, geo_n, lobe, v, lobe_seen)
+                : sky_sums(lights[i], pos.xyz, n, geo_n, lobe, v, lobe_seen);
+            sky = sky_result(sums, int(lights[i].params.z));
+        }
+    imageStore(u_sky_out, px, vec4(sky, 0.0));
+    imageStore(u_sky_sums, px, sums.weights);
+    imageStore(u_sky_blocked, px, vec4(sums.penumbra, 0.0, 0.0));
     return;
 #endif
     vec3 irradiance = vec3(0.0), reflected = vec3(0.0), world = vec3(0.0);

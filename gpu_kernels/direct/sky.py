@@ -1,0 +1,166 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""The sky light's visible shares per G-buffer pixel (direct/light.glsl MODE_SKY, direct/sky.glsl): one shadow test
+per direction of the sky, hundreds of them, summed and then averaged over each pixel's penumbra
+(direct/sky_filter.glsl). The pipeline keeps them across light, material and world edits (they depend on the
+G-buffer and the sky's maps only); after an object's move they are updated, not made anew (SkyUpdate)."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..common import lights as lb
+from ..gl.bind import bind_light_records, bind_samplers, dispatch, read_texture, set_uniform, set_uniforms, ssbo
+from .gbuffer import GBuffer
+from .lighting import bind_inputs
+from .shadows import ShadowAtlas
+
+
+@dataclass
+class SkyShares:
+    """`texture`: RGBA32F, per pixel the shares of the sky's cosine weight (x) and of the glossy lobe's (y) that its
+    directions' tests find visible, and the penumbra's half-width (z, m), filtered; `sums` and `blocked`: the sums
+    they come from (direct/sky.glsl SkySums), unfiltered, which an object's move updates; `made_from`: the depth
+    atlas (serial, generation), the scene's triangles and the G-buffer's key they were made with."""
+    texture: object
+    sums: object
+    blocked: object
+    made_from: tuple = None
+
+    def release(self):
+        for t in (self.texture, self.sums, self.blocked):
+            t.release()
+
+
+@dataclass
+class SkyUpdate:
+    """What an object's move leaves of an earlier SkyShares of the same G-buffer (but where the move covers it) and
+    sky, made from the depth atlas one update ago: `pixels` (x0, y0, x1, y1) the G-buffer rectangle the moved
+    triangles can cover (made anew there), `table` (K, 2, 4) int32 per sky direction its redrawn rectangle and where
+    the texels that rectangle overwrote were kept (direct/sky.glsl SkyRedrawn), `texels` the buffer holding them."""
+    prior: SkyShares
+    pixels: tuple
+    table: np.ndarray
+    texels: object
+
+
+def has_sky(shadows: ShadowAtlas) -> bool:
+    return any(int(t) == lb.LIGHT_SKY for t in shadows.buffers.lights["color_type"][:, 3])
+
+
+def render_sky_visibility(ctx, programs, gbuffer: GBuffer, shadows: ShadowAtlas, material_lut=None,
+                          update: SkyUpdate | None = None) -> SkyShares | None:
+    """The sky light's SkyShares, or None where the scene has no sky light. With `update`, a pixel outside its
+    moved rectangle takes its earlier sums and does again only the tests that read a texel the move redrew: the
+    same sums as testing every direction, to float32 rounding (tests/gpu/test_sky_update.py)."""
+    if not has_sky(shadows):
+        return None
+    w, h = gbuffer.size
+    shares, sums, blocked = (ctx.texture((w, h), 4, dtype="f4") for _ in range(3))
+    prog = programs.compute("direct/light.glsl", {"MODE_SKY": None})
+    for binding, tex in ((2, shares), (3, sums), (4, blocked)):
+        tex.bind_to_image(binding, read=False, write=True)
+    unit = bind_inputs(prog, gbuffer, shadows, material_lut)
+    set_uniforms(prog, {"u_sky_update": update is not None,
+                        "u_moved_pixels": tuple(update.pixels) if update else (0, 0, 0, 0)})
+    table = None
+    if update is not None:
+        unit = bind_samplers(prog, "u_sky_sums_prior", [update.prior.sums], unit)
+        bind_samplers(prog, "u_sky_blocked_prior", [update.prior.blocked], unit)
+        table = [ssbo(ctx, update.table)]
+        table[0].bind_to_storage_buffer(11)
+        table.append(tile_directions(ctx, programs, gbuffer, shadows, update))
+        bind_light_records(shadows)
+        table[1].bind_to_storage_buffer(13)
+        update.texels.bind_to_storage_buffer(12)
+        set_uniforms(prog, {"u_tiles_x": -(-w // TILE), "u_sky_words": -(-len(update.table) // 32)})
+    dispatch(prog, (w, h), local=TILE)
+    for buffer in table or []:
+        buffer.release()
+    return SkyShares(filter_sky_shares(ctx, programs, gbuffer, shares), sums, blocked)
+
+
+TILE = 8  # pixels per side of a work group of direct/light.glsl
+
+
+def tile_boxes(gbuffer: GBuffer, moved: tuple) -> np.ndarray:
+    """(tiles, 2, 4) float32: per TILE × TILE block of pixels (row by row), the box (lo, hi) of the G-buffer points
+    an update takes out and adds back tests at — those outside the `moved` rectangle (x0, y0, x1, y1); an empty box
+    (lo > hi) where there are none."""
+    w, h = gbuffer.size
+    position = read_texture(gbuffer.textures["position"])[::-1]  # (h, w, 4), row 0 the texels' y = 0
+    x, y = np.meshgrid(np.arange(w), np.arange(h))
+    x0, y0, x1, y1 = moved
+    used = (position[..., 3] >= 0.5) & ~((x >= x0) & (x < x1) & (y >= y0) & (y < y1))
+    tw, th = -(-w // TILE), -(-h // TILE)
+    pad = np.zeros((th * TILE, tw * TILE, 3), np.float32)
+    lo, hi = np.full_like(pad, np.inf), np.full_like(pad, -np.inf)
+    lo[:h, :w] = np.where(used[..., None], position[..., :3], np.inf)
+    hi[:h, :w] = np.where(used[..., None], position[..., :3], -np.inf)
+    out = np.zeros((th, tw, 2, 4), np.float32)
+    out[:, :, 0, :3] = lo.reshape(th, TILE, tw, TILE, 3).min(axis=(1, 3))
+    out[:, :, 1, :3] = hi.reshape(th, TILE, tw, TILE, 3).max(axis=(1, 3))
+    return np.nan_to_num(out.reshape(-1, 2, 4), posinf=3.4e38, neginf=-3.4e38)
+
+
+def tile_directions(ctx, programs, gbuffer: GBuffer, shadows: ShadowAtlas, update: SkyUpdate):
+    """Per TILE × TILE block, one bit per sky direction whose redrawn rectangle a test at one of the block's
+    updated points can read (direct/sky_tiles.glsl): a buffer the update reads (direct/sky.glsl SkyTiles)."""
+    w, h = gbuffer.size
+    boxes = ssbo(ctx, tile_boxes(gbuffer, update.pixels))
+    tiles, words = (-(-w // TILE)) * (-(-h // TILE)), -(-len(update.table) // 32)
+    out = ctx.buffer(reserve=4 * tiles * words)
+    prog = programs.compute("direct/sky_tiles.glsl")
+    bind_light_records(shadows)
+    sky = next(i for i, t in enumerate(shadows.buffers.lights["color_type"][:, 3]) if int(t) == lb.LIGHT_SKY)
+    set_uniforms(prog, {"u_first_view": int(shadows.buffers.lights[sky]["params"][1]), "u_tiles": tiles,
+                        "u_directions": len(update.table), "u_words": words,
+                        "u_atlas_texel": (1.0 / shadows.size[0], 1.0 / shadows.size[1])})
+    boxes.bind_to_storage_buffer(13)
+    out.bind_to_storage_buffer(14)
+    dispatch(prog, (tiles * words,), local=64)
+    ctx.memory_barrier()
+    boxes.release()
+    return out
+
+
+def update_table(shadows: ShadowAtlas) -> np.ndarray | None:
+    """SkyUpdate.table for the sky light's directions from the depth atlas's last update (shadows.maps: redrawn,
+    overwritten); None where it cannot serve: a sky view drawn whole, or its overwritten texels not kept."""
+    maps = shadows.maps
+    if maps is None or maps.redrawn is None or maps.overwritten is None:
+        return None
+    kinds = shadows.buffers.lights["color_type"][:, 3].astype(int)
+    sky = [i for i, kind in enumerate(kinds) if kind == lb.LIGHT_SKY]
+    if len(sky) != 1:
+        return None
+    first, count = (int(v) for v in shadows.buffers.lights[sky[0]]["params"][1:3])
+    table = np.zeros((count, 2, 4), np.int32)
+    kept = maps.overwritten.rects
+    for view, rect in maps.redrawn:
+        if not first <= view < first + count:
+            continue
+        if rect is None or view not in kept:
+            return None
+        x, y, w, h, start = kept[view]
+        table[view - first] = ((x, y, x + w, y + h), (start, w, 0, 0))
+    return table
+
+
+def filter_sky_shares(ctx, programs, gbuffer: GBuffer, shares):
+    """The sky's shares averaged over each pixel's penumbra on its own surface, one image axis at a time
+    (direct/sky_filter.glsl); releases `shares`."""
+    w, h = gbuffer.size
+    prog = programs.compute("direct/sky_filter.glsl")
+    unit = bind_samplers(prog, "u_position", [gbuffer.textures["position"]], 0)
+    unit = bind_samplers(prog, "u_geo_normal", [gbuffer.textures["geo_normal"]], unit)
+    set_uniform(prog, "u_size", (w, h))
+    for axis in ((1, 0), (0, 1)):
+        out = ctx.texture((w, h), 4, dtype="f4")
+        bind_samplers(prog, "u_shares", [shares], unit)
+        out.bind_to_image(0, read=False, write=True)
+        set_uniform(prog, "u_axis", axis)
+        dispatch(prog, (w, h), local=8)
+        shares.release()
+        shares = out
+    return shares

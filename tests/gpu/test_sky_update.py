@@ -1,0 +1,50 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""The sky's visibility after an object's move (direct/sky.py SkyUpdate): each pixel takes the sums it had and does
+again only the tests of the directions whose maps the move redrew where they can read a redrawn texel — the old
+result of each (from the depths the redraw overwrote, direct/shadows.keep_texels) taken out, the new one added.
+Against a cold render of the moved scene: the same Diffuse and Glossy Direct to float32 rounding of the sums
+(1e-5 of the image's mean: a test taken out with the wrong texels is a whole direction's share, 1/64 here)."""
+import numpy as np
+
+from bounce_gi.gpu_kernels.common.lights import ShadowSettings
+from bounce_gi.gpu_kernels.direct import sky
+from bounce_gi.gpu_kernels.scene import Material
+from bounce_gi.gpu_kernels.settings import RenderSettings
+from support.synthetic import box_quads, quad, quad_scene
+
+SETTINGS = RenderSettings(method="lpv", width=96, height=72, shadow=ShadowSettings(
+    cube_resolution=128, sky_directions=64, sky_resolution=64))
+
+
+def _yard(x):
+    """A floor, two walls and a box at `x`, lit by a blue sky alone."""
+    floor = quad([(-4, -4, 0), (4, -4, 0), (4, 4, 0), (-4, 4, 0)], (0, 0, 1))
+    wall = quad([(-4, 4, 0), (4, 4, 0), (4, 4, 3), (-4, 4, 3)], (0, -1, 0))
+    side = quad([(-4, -4, 0), (-4, 4, 0), (-4, 4, 3), (-4, -4, 3)], (1, 0, 0))
+    quads = [(floor, 0), (wall, 0), (side, 0)] + box_quads((x - 0.5, -0.5, 0.0), (x + 0.5, 0.5, 1.2), 1,
+                                                            inward=False)
+    return quad_scene(quads, [Material("floor", (0.6, 0.6, 0.6)), Material("box", (0.8, 0.3, 0.2))], [],
+                      eye=(1.0, -7.0, 5.0), target=(0.0, 0.5, 0.5), world=(0.4, 0.5, 0.7))
+
+
+def test_an_object_move_updates_the_skys_visibility_to_what_a_cold_render_gives(engines, monkeypatch):
+    warm, cold = engines
+    updates, shares, tile_directions = [], [], sky.tile_directions
+
+    def counted(ctx, programs, gbuffer, shadows, update):
+        out = tile_directions(ctx, programs, gbuffer, shadows, update)
+        bits = np.unpackbits(np.frombuffer(out.read(), np.uint32).view(np.uint8))
+        shares.append(bits.mean() * 32 * (-(-len(update.table) // 32)) / len(update.table))
+        updates.append(update)
+        return out
+    monkeypatch.setattr(sky, "tile_directions", counted)
+    warm.render(_yard(0.0), SETTINGS)
+    for x in (0.3, 0.6):
+        result = warm.render(_yard(x), SETTINGS)
+        fresh = cold.render(_yard(x), SETTINGS)
+        cold.clear_cache()
+        for name in ("Diffuse Direct", "Glossy Direct", "Combined"):
+            a, b = result.passes[name], fresh.passes[name]
+            assert np.abs(a - b).max() <= 1e-5 * np.abs(b).mean(), name
+    print("share of (block, direction) pairs tested again:", shares)
+    assert len(updates) == 2 and all(0.0 < s < 0.5 for s in shares)
