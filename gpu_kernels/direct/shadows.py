@@ -153,12 +153,17 @@ class DepthAtlas:
 @dataclass
 class KeptTexels:
     """Depths an update of the atlas overwrote (keep_texels): per view index, (x, y, w, h, first) — its redrawn
-    rectangle in atlas texels and where its texels start in `buffer` (float32, row by row)."""
+    rectangle in atlas texels and where its texels start in `buffer` (float32, row by row); `changed` per view the
+    box (x0, y0, x1, y1) of the texels the update changed in it, None where it changed none (find_changed)."""
     buffer: object
     rects: dict
+    table: object = None  # the rectangles on the GPU (keep_texels.glsl Rects)
+    changed: dict = None
 
     def release(self):
         self.buffer.release()
+        if self.table is not None:
+            self.table.release()
 
 
 # The most texels an update keeps (64 MiB): a move whose rectangles hold more (an object filling the sky's maps)
@@ -169,27 +174,46 @@ MAX_KEPT_TEXELS = 1 << 24
 def keep_texels(ctx, programs, depth, rects: list) -> KeptTexels | None:
     """The depths of `depth` inside `rects` ((view, (x, y, w, h)) pairs), copied before they are drawn over
     (direct/keep_texels.glsl); None where there are none or more than MAX_KEPT_TEXELS."""
-    import moderngl
-
     total = sum(w * h for _, (_, _, w, h) in rects)
     if not rects or total > MAX_KEPT_TEXELS:
         return None
     firsts = np.concatenate([[0], np.cumsum([w * h for _, (_, _, w, h) in rects])[:-1]]).astype(np.int64)
-    table = np.array([(x, y, w, h, int(f), 0, 0, 0) for (_, (x, y, w, h)), f in zip(rects, firsts)], np.int32)
+    table = ssbo(ctx, np.array([(x, y, w, h, int(f), 0, 0, 0) for (_, (x, y, w, h)), f in zip(rects, firsts)],
+                               np.int32))
     out = ctx.buffer(reserve=4 * total)
-    buffers = [ssbo(ctx, table)]
+    _run_over_rects(ctx, programs, depth, rects, table, out, None)
+    return KeptTexels(out, {v: (x, y, w, h, int(f)) for (v, (x, y, w, h)), f in zip(rects, firsts)}, table)
+
+
+def find_changed(ctx, programs, depth, kept: KeptTexels) -> None:
+    """kept.changed: per view the box of the texels whose depth the draws changed, compared with the kept ones
+    (keep_texels.glsl MODE_CHANGED). A small object's move in a large scene changes few of the texels its box's
+    rectangles hold (the rectangles grow by MOVED_MARGIN texels, and its own texels are coarse)."""
+    rects = [(v, r[:4]) for v, r in kept.rects.items()]
+    start = np.tile(np.array([1 << 30, 1 << 30, -1, -1], np.int32), len(rects))
+    boxes = ctx.buffer(start.tobytes())
+    _run_over_rects(ctx, programs, depth, rects, kept.table, kept.buffer, boxes)
+    found = np.frombuffer(boxes.read(), np.int32).reshape(-1, 4)
+    boxes.release()
+    kept.changed = {v: tuple(int(c) for c in box) if box[2] > box[0] else None for (v, _), box in zip(rects, found)}
+
+
+def _run_over_rects(ctx, programs, depth, rects: list, table, texels, changed) -> None:
+    """keep_texels.glsl over every texel of `rects`: copy them into `texels`, or (`changed` given) compare."""
+    import moderngl
+
     raw = ctx.sampler(repeat_x=False, repeat_y=False, filter=(moderngl.NEAREST, moderngl.NEAREST), compare_func="",
                       texture=depth)
-    prog = programs.compute("direct/keep_texels.glsl")
+    prog = programs.compute("direct/keep_texels.glsl", None if changed is None else {"MODE_CHANGED": None})
     raw.use(location=0)
     set_uniform(prog, "u_depth", 0)
-    buffers[0].bind_to_storage_buffer(0)
-    out.bind_to_storage_buffer(1)
+    table.bind_to_storage_buffer(0)
+    texels.bind_to_storage_buffer(1)
+    if changed is not None:
+        changed.bind_to_storage_buffer(2)
     dispatch(prog, (max(w for _, (_, _, w, _) in rects), max(h for _, (_, _, _, h) in rects), len(rects)))
     ctx.memory_barrier()
     raw.release()
-    buffers[0].release()
-    return KeptTexels(out, {v: (x, y, w, h, int(f)) for (v, (x, y, w, h)), f in zip(rects, firsts)})
 
 
 def view_rows(views: list) -> np.ndarray:
@@ -266,6 +290,8 @@ def render_depth(ctx, programs, geometry: GeometryBuffers, views: list, tiles: l
             geometry.vao_depth.render(moderngl.TRIANGLES)
         ctx.scissor = None
         fbo.release()
+    if plan is not None and prior.overwritten is not None:
+        find_changed(ctx, programs, depth, prior.overwritten)
     partial = sum(rect is not None for _, rect in draws)
     if plan is not None:
         prior.views, prior.drawn, prior.drawn_from, prior.partial = rows, len(draws), positions, partial

@@ -36,8 +36,9 @@ class SkyShares:
 class SkyUpdate:
     """What an object's move leaves of an earlier SkyShares of the same G-buffer (but where the move covers it) and
     sky, made from the depth atlas one update ago: `pixels` (x0, y0, x1, y1) the G-buffer rectangle the moved
-    triangles can cover (made anew there), `table` (K, 2, 4) int32 per sky direction its redrawn rectangle and where
-    the texels that rectangle overwrote were kept (direct/sky.glsl SkyRedrawn), `texels` the buffer holding them."""
+    triangles can cover (made anew there), `table` (K, 2, 4) int32 per sky direction the box of the texels its
+    redraw changed and where those it overwrote were kept (direct/sky.glsl SkyRedrawn), `texels` the buffer holding
+    them."""
     prior: SkyShares
     pixels: tuple
     table: np.ndarray
@@ -136,14 +137,14 @@ def update_table(shadows: ShadowAtlas) -> np.ndarray | None:
         return None
     first, count = (int(v) for v in shadows.buffers.lights[sky[0]]["params"][1:3])
     table = np.zeros((count, 2, 4), np.int32)
-    kept = maps.overwritten.rects
+    kept, changed = maps.overwritten.rects, maps.overwritten.changed
     for view, rect in maps.redrawn:
         if not first <= view < first + count:
             continue
         if rect is None or view not in kept:
             return None
         x, y, w, h, start = kept[view]
-        table[view - first] = ((x, y, x + w, y + h), (start, w, 0, 0))
+        table[view - first] = (changed[view] or (0, 0, 0, 0), (start, w, x, y))
     return table
 
 

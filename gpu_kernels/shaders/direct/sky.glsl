@@ -67,9 +67,9 @@ vec3 sky_result(SkySums s, int samples) {
 }
 
 #if defined(MODE_SKY)
-// After an object's move (direct/sky.py SkyUpdate): per direction k, the rectangle its view redrew (sky_redrawn[2k]:
-// x0, y0, x1, y1 in atlas texels, empty where it redrew none) and where the texels it overwrote were kept
-// (sky_redrawn[2k + 1]: first index in old_texels, the rectangle's width).
+// After an object's move (direct/sky.py SkyUpdate): per direction k, the box of the texels its redraw changed
+// (sky_redrawn[2k]: x0, y0, x1, y1 in atlas texels, empty where it changed none) and where those its redrawn
+// rectangle overwrote were kept (sky_redrawn[2k + 1]: its first index in old_texels, width, x, y).
 layout(std430, binding = 11) readonly buffer SkyRedrawn { ivec4 sky_redrawn[]; };
 layout(std430, binding = 12) readonly buffer OldTexels { float old_texels[]; };
 
@@ -107,7 +107,7 @@ SkySums sky_sums_update(SkySums s, GpuLight L, vec3 p, vec3 n, vec3 geo_n, Gloss
         for (int i = 0; i < 4; ++i) {
             ivec2 t = t0 + ivec2(i & 1, i >> 1);
             bool redrawn = all(greaterThanEqual(t, r.xy)) && all(lessThan(t, r.zw));
-            nearest = min(nearest, redrawn ? old_texels[kept.x + (t.y - r.y) * kept.y + t.x - r.x]
+            nearest = min(nearest, redrawn ? old_texels[kept.x + (t.y - kept.w) * kept.y + t.x - kept.z]
                                            : texelFetch(u_shadow_depth, t, 0).r);
         }
         float gap_old = depth - nearest;
