@@ -265,9 +265,10 @@ class Pipeline:
             None if shares is None else shares.texture, prior, relight), "made_from": made_from})
 
     def _moved_since(self, frame, made_from) -> tuple | None:
-        """(the G-buffer rectangle the moved triangles can cover, the depth atlas's last redraw) where an output
-        made from `made_from` (its depth atlas's serial and generation, triangles and G-buffer key) was made one
-        update of the same atlas ago, for the same camera; else None."""
+        """(the G-buffer rectangle the moved triangles can cover, the depth atlas's last redraw cut to the texels it
+        changed: shadows.changed_views) where an output made from `made_from` (its depth atlas's serial and
+        generation, triangles and G-buffer key) was made one update of the same atlas ago, for the same camera; else
+        None."""
         keys, maps, scene = frame.keys, frame.shadows.maps, frame.scene
         serial, generation, surfaces, gbuffer_key = made_from
         if maps.redrawn is None or (serial, generation + 1) != (maps.serial, maps.generation) \
@@ -277,7 +278,7 @@ class Pipeline:
         if box is False:
             return None
         w, h = frame.gbuffer.size
-        return (0, 0, 0, 0) if box is None else gb.box_pixels(scene, w, h, box), maps.redrawn
+        return (0, 0, 0, 0) if box is None else gb.box_pixels(scene, w, h, box), sh.changed_views(maps)
 
     def _relight(self, frame) -> lighting.Relight | None:
         """After an object's move, the kept Diffuse Direct of the same camera, materials and shadow settings, lit

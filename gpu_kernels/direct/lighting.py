@@ -31,8 +31,9 @@ class Relight:
     """What an object's move leaves of an earlier output of render_direct_light (same camera, materials and shadow
     settings, lit from the same depth atlas one update ago): `prior` that output, `pixels` the G-buffer rectangle
     (x0, y0, x1, y1) the moved triangles can cover (direct/gbuffer.box_pixels), `redrawn` the depth atlas's last
-    update (shadows.DepthAtlas.redrawn). A group whose lights are unchanged is lit again only at the pixels inside
-    `pixels` or whose shadow tests read a redrawn texel of its lights' views (direct/light.glsl u_masked)."""
+    update cut to the texels it changed (shadows.changed_views). A group whose lights are unchanged is lit again only
+    at the pixels inside `pixels` or whose shadow tests read a changed texel of its lights' views (direct/light.glsl
+    u_masked)."""
     prior: dict
     pixels: tuple
     redrawn: list

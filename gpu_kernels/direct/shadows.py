@@ -72,11 +72,8 @@ def render_shadow_atlas(ctx, programs, scene: Scene, geometry: GeometryBuffers,
 
     rows = view_rows(buffers.views)
 
-    sky = frozenset(i for i, light in enumerate(buffers.view_lights)
-                    if int(buffers.lights[light]["color_type"][3]) == lb.LIGHT_SKY)
-
     def render(prior=None):
-        return render_depth(ctx, programs, geometry, buffers.views, tiles, size, prior, rows, scene.positions, sky)
+        return render_depth(ctx, programs, geometry, buffers.views, tiles, size, prior, rows, scene.positions)
 
     key = depth_key(rows, tiles, size)
     maps = render() if depth_pass is None else depth_pass(key, render)
@@ -166,9 +163,9 @@ class KeptTexels:
             self.table.release()
 
 
-# The most texels an update keeps (64 MiB): a move whose rectangles hold more (an object filling the sky's maps)
-# keeps none, and what would have read them is made anew.
-MAX_KEPT_TEXELS = 1 << 24
+# The most texels an update keeps (16 MiB; the example scenes' object moves keep 0.05-2.9 M): a move whose rectangles
+# hold more keeps none, and what reads them is lit again as if every texel of the rectangles had changed.
+MAX_KEPT_TEXELS = 1 << 22
 
 
 def keep_texels(ctx, programs, depth, rects: list) -> KeptTexels | None:
@@ -245,14 +242,14 @@ def redraw_plan(prior, views: list, tiles: list, size: tuple, rows: np.ndarray, 
 
 def render_depth(ctx, programs, geometry: GeometryBuffers, views: list, tiles: list, size: tuple,
                  prior: DepthAtlas | None = None, rows: np.ndarray | None = None,
-                 positions: np.ndarray | None = None, keep: frozenset = frozenset()) -> DepthAtlas:
+                 positions: np.ndarray | None = None) -> DepthAtlas:
     """The depth atlas: every view drawn into its tile (direct/shadow_depth.glsl). With `prior` (an atlas tiled
     alike) only what changed is drawn again, into `prior`, which is returned updated: whoever held it sees the new
     maps (the pass cache, whose entry it then is) — the tiles whose view changed (a light's move redraws that light's
     maps), and where the scene's triangles (`positions`) moved since `prior` was drawn, in every other tile the
-    rectangle the moved triangles' box covers (moved_rects). `rows`: view_rows(views). The depths the rectangles of
-    the views in `keep` overwrite are kept (DepthAtlas.overwritten: the sky's, whose tests direct/sky.py takes out
-    and adds back)."""
+    rectangle the moved triangles' box covers (moved_rects). `rows`: view_rows(views). The depths the rectangles
+    overwrite are kept, and which of them changed found (DepthAtlas.overwritten, changed_views): the sky's tests are
+    taken out and added back from them (direct/sky.py), and what reads none of the changed texels keeps its light."""
     import moderngl
 
     rows = view_rows(views) if rows is None else rows
@@ -269,7 +266,7 @@ def render_depth(ctx, programs, geometry: GeometryBuffers, views: list, tiles: l
     if plan is not None:
         if prior.overwritten is not None:
             prior.overwritten.release()
-        prior.overwritten = keep_texels(ctx, programs, depth, [(i, r) for i, r in draws if r is not None and i in keep])
+        prior.overwritten = keep_texels(ctx, programs, depth, [(i, r) for i, r in draws if r is not None])
     if draws:
         fbo = ctx.framebuffer(depth_attachment=depth)
         fbo.use()
@@ -298,6 +295,22 @@ def render_depth(ctx, programs, geometry: GeometryBuffers, views: list, tiles: l
         prior.generation, prior.redrawn = prior.generation + 1, draws
         return prior
     return DepthAtlas(depth, tiles, size, rows, len(draws), positions)
+
+
+def changed_views(maps: DepthAtlas) -> list:
+    """maps.redrawn with each rectangle cut to the box of the texels its redraw changed where they were compared
+    (KeptTexels.changed), and the views whose redraw changed none left out: a test that reads none of them gives
+    what it gave before."""
+    kept = maps.overwritten
+    changed = kept.changed if kept is not None and kept.changed is not None else {}
+    out = []
+    for view, rect in maps.redrawn:
+        if rect is None or view not in changed:
+            out.append((view, rect))
+        elif changed[view] is not None:
+            x0, y0, x1, y1 = changed[view]
+            out.append((view, (x0, y0, x1 - x0, y1 - y0)))
+    return out
 
 
 def moved_box(before, after):

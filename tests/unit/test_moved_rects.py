@@ -1,12 +1,13 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """What an object's move redraws and re-makes: the rectangles its box covers in the shadow and RSM views
 (direct/shadows.moved_rects) and the RSM records merged from the kept ones and those of the redrawn blocks
-(lpv/gather.merge_records). The GPU side, against cold renders: tests/gpu/test_light_edits.py and
-tests/gpu/test_lpv_transfer.py."""
+(lpv/gather.merge_records), and the texels of those rectangles a redraw changed (direct/shadows.changed_views). The
+GPU side, against cold renders: tests/gpu/test_light_edits.py, tests/gpu/test_sky_update.py and
+tests/gpu/test_lpv_transfer_update.py."""
 import numpy as np
 
 from bounce_gi.gpu_kernels.common.lights import cube_views
-from bounce_gi.gpu_kernels.direct.shadows import MOVED_MARGIN, moved_rects
+from bounce_gi.gpu_kernels.direct.shadows import MOVED_MARGIN, changed_views, moved_rects
 from bounce_gi.gpu_kernels.lpv.gather import VPL_DTYPE, covered_blocks, merge_records
 
 
@@ -89,3 +90,16 @@ def test_merged_records_are_the_kept_ones_outside_the_redrawn_blocks_and_the_new
     want = np.sort(np.concatenate([old_slots[~in_new[old_slots]], new_slots]))
     assert np.array_equal(slots, want) and np.array_equal(got["flux"][:, 1], want)
     assert np.array_equal(got["flux"][:, 0], np.where(in_new[want], 2.0, 1.0))
+
+
+def test_changed_views_cut_each_rectangle_to_the_texels_that_changed():
+    """shadows.changed_views: a rectangle whose kept texels were compared becomes the box of those that changed, a
+    view none of whose texels changed drops out, and a view drawn whole or not compared stays as it was."""
+    from types import SimpleNamespace
+
+    kept = SimpleNamespace(changed={0: (12, 14, 15, 16), 1: None})
+    maps = SimpleNamespace(redrawn=[(0, (10, 10, 8, 8)), (1, (30, 30, 4, 4)), (2, None), (3, (50, 50, 2, 2))],
+                           overwritten=kept)
+    assert changed_views(maps) == [(0, (12, 14, 3, 2)), (2, None), (3, (50, 50, 2, 2))]
+    maps.overwritten = None  # nothing kept (too many texels): every rectangle as it was drawn
+    assert changed_views(maps) == maps.redrawn
