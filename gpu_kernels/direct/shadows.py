@@ -163,9 +163,10 @@ class KeptTexels:
             self.table.release()
 
 
-# The most texels an update keeps (16 MiB; the example scenes' object moves keep 0.05-2.9 M): a move whose rectangles
-# hold more keeps none, and what reads them is lit again as if every texel of the rectangles had changed.
-MAX_KEPT_TEXELS = 1 << 22
+# The most texels an update keeps (16 MiB, one dispatch of groups of 64; the example scenes' object moves keep
+# 0.05-2.9 M): a move whose rectangles hold more keeps none, and what reads them is lit again as if every texel of
+# the rectangles had changed.
+MAX_KEPT_TEXELS = 65535 * 64
 
 
 def keep_texels(ctx, programs, depth, rects: list) -> KeptTexels | None:
@@ -208,7 +209,10 @@ def _run_over_rects(ctx, programs, depth, rects: list, table, texels, changed) -
     texels.bind_to_storage_buffer(1)
     if changed is not None:
         changed.bind_to_storage_buffer(2)
-    dispatch(prog, (max(w for _, (_, _, w, _) in rects), max(h for _, (_, _, _, h) in rects), len(rects)))
+    total = sum(w * h for _, (_, _, w, h) in rects)
+    set_uniform(prog, "u_rects", len(rects))
+    set_uniform(prog, "u_total", total)
+    dispatch(prog, (total,), local=64)
     ctx.memory_barrier()
     raw.release()
 

@@ -1,9 +1,12 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The depths inside some rectangles of the shadow atlas, copied before an object's move draws over them
-// (direct/shadows.keep_texels): one rectangle per z, row by row from its first index. MODE_CHANGED, after the
-// draws: per rectangle the box of the texels whose depth the draws changed (x0, y0, x1, y1; x1 ≤ x0: none).
-layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;  // gl/bind.VOLUME_GROUP
+// (direct/shadows.keep_texels), rectangle after rectangle, each row by row. MODE_CHANGED, after the draws: per
+// rectangle the box of the texels whose depth the draws changed (x0, y0, x1, y1; x1 ≤ x0: none). One invocation
+// per texel of them all (a dispatch per rectangle's box would run the largest's size for every one of them).
+layout(local_size_x = 64) in;
 uniform sampler2D u_depth;   // the atlas's depths, nearest, without comparison
+uniform int u_rects;
+uniform int u_total;         // texels in all the rectangles
 layout(std430, binding = 0) readonly buffer Rects { ivec4 rects[]; };   // per rectangle: (x, y, w, h), (first, …)
 #if defined(MODE_CHANGED)
 layout(std430, binding = 1) readonly buffer Texels { float texels[]; };
@@ -13,18 +16,23 @@ layout(std430, binding = 1) writeonly buffer Texels { float texels[]; };
 #endif
 
 void main() {
-    ivec3 id = ivec3(gl_GlobalInvocationID);
-    ivec4 r = rects[2 * id.z];
-    if (id.x >= r.z || id.y >= r.w) return;
-    int i = rects[2 * id.z + 1].x + id.y * r.z + id.x;
-    float depth = texelFetch(u_depth, r.xy + id.xy, 0).r;
+    int i = int(gl_GlobalInvocationID.x);
+    if (i >= u_total) return;
+    int lo = 0, hi = u_rects - 1;   // the last rectangle starting at or before texel i
+    while (lo < hi) {
+        int mid = (lo + hi + 1) / 2;
+        if (rects[2 * mid + 1].x <= i) lo = mid; else hi = mid - 1;
+    }
+    ivec4 r = rects[2 * lo];
+    int local = i - rects[2 * lo + 1].x;
+    ivec2 t = r.xy + ivec2(local % r.z, local / r.z);
+    float depth = texelFetch(u_depth, t, 0).r;
 #if defined(MODE_CHANGED)
     if (texels[i] == depth) return;
-    ivec2 t = r.xy + id.xy;
-    atomicMin(changed[4 * id.z], t.x);
-    atomicMin(changed[4 * id.z + 1], t.y);
-    atomicMax(changed[4 * id.z + 2], t.x + 1);
-    atomicMax(changed[4 * id.z + 3], t.y + 1);
+    atomicMin(changed[4 * lo], t.x);
+    atomicMin(changed[4 * lo + 1], t.y);
+    atomicMax(changed[4 * lo + 2], t.x + 1);
+    atomicMax(changed[4 * lo + 3], t.y + 1);
 #else
     texels[i] = depth;
 #endif
