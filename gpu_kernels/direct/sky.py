@@ -15,6 +15,8 @@ from .gbuffer import GBuffer
 from .lighting import bind_inputs
 from .shadows import ShadowAtlas
 
+TILE = 8  # pixels per side of a work group of direct/light.glsl: the blocks an update lists directions for
+
 
 @dataclass
 class SkyShares:
@@ -46,6 +48,7 @@ class SkyUpdate:
 
 
 def has_sky(shadows: ShadowAtlas) -> bool:
+    """Whether the scene's lights include the sky (the world as a light)."""
     return any(int(t) == lb.LIGHT_SKY for t in shadows.buffers.lights["color_type"][:, 3])
 
 
@@ -64,24 +67,22 @@ def render_sky_visibility(ctx, programs, gbuffer: GBuffer, shadows: ShadowAtlas,
     unit = bind_inputs(prog, gbuffer, shadows, material_lut)
     set_uniforms(prog, {"u_sky_update": update is not None,
                         "u_moved_pixels": tuple(update.pixels) if update else (0, 0, 0, 0)})
-    table = None
+    buffers = []
     if update is not None:
         unit = bind_samplers(prog, "u_sky_sums_prior", [update.prior.sums], unit)
         bind_samplers(prog, "u_sky_blocked_prior", [update.prior.blocked], unit)
-        table = [ssbo(ctx, update.table)]
-        table[0].bind_to_storage_buffer(11)
-        table.append(tile_directions(ctx, programs, gbuffer, shadows, update))
+        buffers.append(ssbo(ctx, update.table))
+        buffers[0].bind_to_storage_buffer(11)  # read by tile_directions too
+        buffers.append(tile_directions(ctx, programs, gbuffer, shadows, update))
         bind_light_records(shadows)
-        table[1].bind_to_storage_buffer(13)
+        buffers[1].bind_to_storage_buffer(13)
         update.texels.bind_to_storage_buffer(12)
         set_uniforms(prog, {"u_tiles_x": -(-w // TILE), "u_sky_words": -(-len(update.table) // 32)})
     dispatch(prog, (w, h), local=TILE)
-    for buffer in table or []:
+    for buffer in buffers:
         buffer.release()
     return SkyShares(filter_sky_shares(ctx, programs, gbuffer, shares), sums, blocked)
 
-
-TILE = 8  # pixels per side of a work group of direct/light.glsl
 
 
 def tile_boxes(gbuffer: GBuffer, moved: tuple) -> np.ndarray:
