@@ -88,7 +88,7 @@ def light_signatures(buffers: lb.LightBuffers, packed: np.ndarray) -> list:
     """Per light, a key of what its shadow maps and its light are made from besides its colour (and the geometry):
     its record (colour left out), its polygon and its views as packed (atlas.pack_views: projection, tile, texel
     size, PCF radius). An edit that leaves a light's key leaves whatever was made from that light alone: its
-    Diffuse Direct (direct/lighting.py), the sky's visibility (pipeline.py), its first bounce (lpv/passes.py)."""
+    Diffuse Direct (direct/lighting.py), the sky's visibility (direct/sky.py), its first bounce (lpv/passes.py)."""
     owner = np.asarray(buffers.view_lights or [], np.int64)
     out = []
     for i, rec in enumerate(buffers.lights):

@@ -27,7 +27,7 @@ uniform ivec2 u_size;
 // The pass runs once per group of lights (direct/lighting.py light_groups): these u_group_count lights.
 uniform int u_group_count;
 layout(std430, binding = 9) readonly buffer GroupLights { int group_lights[]; };
-// The sky light's shares come from the sky_visibility pass (MODE_SKY, direct/lighting.py) where u_sky_cached:
+// The sky light's shares come from the sky_visibility pass (MODE_SKY, direct/sky.py) where u_sky_cached:
 // they depend on the G-buffer and the sky's shadow maps only, so a world colour edit reads them back.
 uniform bool u_sky_cached;
 uniform sampler2D u_sky_shares;
