@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """An object's move in the LPV's cached transport: what it draws, voxelises and records again is only what the move
-can change, and the result is a cold render's (the transfer's update: tests/gpu/test_lpv_transfer.py)."""
+can change, and the result is a cold render's (the transfer's update: tests/gpu/test_lpv_transfer_update.py)."""
 from dataclasses import replace
 
 import numpy as np
@@ -10,17 +10,11 @@ from bounce_gi.gpu_kernels.lpv import gather, regional
 from bounce_gi.gpu_kernels.lpv.settings import LpvSettings
 from bounce_gi.gpu_kernels.scene import Light, Material
 from bounce_gi.gpu_kernels.settings import RenderSettings
+from support.lpv_transfer import assert_same, indirect
 from support.synthetic import room_with_box
 
 SETTINGS = RenderSettings("lpv", 48, 36, lpv=LpvSettings(resolution=16))
 
-
-def _indirect(result):
-    return result.passes["Diffuse Indirect"]
-
-
-def _same(a, b):
-    assert np.abs(a - b).max() <= 1e-5 * max(float(np.abs(b).mean()), 1e-12)
 
 
 def test_an_objects_move_voxelises_only_the_region_it_changed(monkeypatch):
@@ -42,7 +36,7 @@ def test_an_objects_move_voxelises_only_the_region_it_changed(monkeypatch):
     for name in ("cells", "axis", "surface_normal", "surface_area", "positions", "surface_albedo"):
         assert np.array_equal(getattr(gv, name), getattr(gv_cold, name)), name
     assert np.array_equal(gv.bounds[0], gv_cold.bounds[0]) and np.array_equal(gv.bounds[1], gv_cold.bounds[1])
-    _same(_indirect(moved), _indirect(fresh))
+    assert_same(indirect(moved), indirect(fresh))
 
 
 def test_an_objects_move_makes_again_only_the_records_of_the_texels_it_covers(monkeypatch):
@@ -66,7 +60,7 @@ def test_an_objects_move_makes_again_only_the_records_of_the_texels_it_covers(mo
     assert 0 < calls[1].sum() < 0.5 * calls[1].size
     kept, new = (e.pipeline.cache.entries["lpv_inject"].value.records[0] for e in (engine, cold))
     assert np.array_equal(kept[1], new[1]) and kept[0].tobytes() == new[0].tobytes()
-    _same(_indirect(moved), _indirect(fresh))
+    assert_same(indirect(moved), indirect(fresh))
 
 
 def test_a_material_given_to_an_object_is_drawn_into_the_kept_maps():
@@ -80,8 +74,8 @@ def test_a_material_given_to_an_object_is_drawn_into_the_kept_maps():
     engine = Engine()
     before = engine.render(scene(1), SETTINGS)
     after = engine.render(scene(2), SETTINGS)
-    assert np.abs(_indirect(after) - _indirect(before)).max() > 1e-3 * _indirect(before).mean()  # it did change
-    _same(_indirect(after), _indirect(Engine().render(scene(2), SETTINGS)))
+    assert np.abs(indirect(after) - indirect(before)).max() > 1e-3 * indirect(before).mean()  # it did change
+    assert_same(indirect(after), indirect(Engine().render(scene(2), SETTINGS)))
 
 
 def test_an_object_moved_out_of_every_view_keeps_every_record(monkeypatch):
@@ -101,4 +95,4 @@ def test_an_object_moved_out_of_every_view_keeps_every_record(monkeypatch):
     moved = engine.render(scene(0.05), SETTINGS)
     assert len(calls) == 1  # the first render's; the move made none
     assert engine.pipeline.cache.entries["rsm"].value.redrawn == []
-    _same(_indirect(moved), _indirect(Engine().render(scene(0.05), SETTINGS)))
+    assert_same(indirect(moved), indirect(Engine().render(scene(0.05), SETTINGS)))

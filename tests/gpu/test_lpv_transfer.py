@@ -18,6 +18,7 @@ from bounce_gi.gpu_kernels.lpv import lighting, receivers
 from bounce_gi.gpu_kernels.lpv.settings import LpvSettings
 from bounce_gi.gpu_kernels.scene import Light, Material, World
 from bounce_gi.gpu_kernels.settings import RenderSettings
+from support.lpv_transfer import assert_same, indirect, rerun
 from support.synthetic import box_quads, quad_scene
 
 GEOMETRY_PASSES = ("geometry", "geometry_volume", "lpv_transfer")
@@ -34,17 +35,6 @@ def _room(light_x=-0.4, power=60.0, floor=(0.7, 0.7, 0.7), world=(0.0, 0.0, 0.0)
     return quad_scene(quads, mats, [Light("bulb", "POINT", (1, 1, 1), power, bulb)], (0.0, -0.95, 1.0),
                       (0.0, 0.5, 0.6), world=world, lens=12.0)
 
-
-def _indirect(result):
-    return result.passes["Diffuse Indirect"]
-
-
-def _rerun(result):
-    return [k for k, v in result.timings.items() if k != "total" and k not in result.skipped]
-
-
-def _same(a, b):
-    assert np.abs(a - b).max() <= 1e-5 * max(float(np.abs(b).mean()), 1e-12)
 
 
 @pytest.fixture(scope="module")
@@ -68,20 +58,20 @@ def test_an_edit_reuses_the_transfer_and_matches_a_render_from_scratch(warm, edi
     is a cold render's to float32 rounding (see the module docstring)."""
     scene = _room(**edit)
     cached = warm.render(scene, SETTINGS)
-    rerun = set(_rerun(cached))
-    print(edit, "re-ran", sorted(rerun))
-    assert expected <= rerun and not rerun & (set(GEOMETRY_PASSES) | kept)
+    ran = set(rerun(cached))
+    print(edit, "re-ran", sorted(ran))
+    assert expected <= ran and not ran & (set(GEOMETRY_PASSES) | kept)
     cold = Engine().render(scene, SETTINGS)
-    assert _indirect(cold).max() > 0
-    _same(_indirect(cached), _indirect(cold))
+    assert indirect(cold).max() > 0
+    assert_same(indirect(cached), indirect(cold))
     warm.render(_room(), SETTINGS)  # back to the module's scene
 
 
 def test_indirect_light_is_linear_in_the_light_power(warm):
     """The transport is linear in the light entering it: twice the power, twice the indirect light (1e-5: float32)."""
-    a = _indirect(warm.render(_room(power=60.0), SETTINGS))
-    b = _indirect(warm.render(_room(power=120.0), SETTINGS))
-    _same(b, 2.0 * a)
+    a = indirect(warm.render(_room(power=60.0), SETTINGS))
+    b = indirect(warm.render(_room(power=120.0), SETTINGS))
+    assert_same(b, 2.0 * a)
 
 
 def test_every_bounce_is_summed_and_the_series_stops_when_it_no_longer_adds(warm):
@@ -113,7 +103,7 @@ def test_the_dense_light_volumes_and_the_sparse_index_look_up_the_same_light(mon
     dense = Engine().render(_room(), SETTINGS)
     monkeypatch.setattr(receivers, "LIGHT_VOLUME_BYTES", 0)
     sparse = Engine().render(_room(), SETTINGS)
-    a, b = _indirect(dense), _indirect(sparse)
+    a, b = indirect(dense), indirect(sparse)
     print("dense vs sparse, max |difference| / mean:", np.abs(a - b).max() / b.mean())
     assert b.mean() > 0 and np.abs(a - b).max() <= 1e-4 * b.mean()
 
@@ -285,5 +275,5 @@ def test_skipping_empty_space_changes_no_visibility(monkeypatch, transport):
     skipped = Engine().render(_room(), settings)
     monkeypatch.setattr(crossings, "mark_empty_space", lambda coverage: None)
     walked = Engine().render(_room(), settings)
-    assert _indirect(walked).max() > 0
-    assert np.array_equal(_indirect(skipped), _indirect(walked))
+    assert indirect(walked).max() > 0
+    assert np.array_equal(indirect(skipped), indirect(walked))

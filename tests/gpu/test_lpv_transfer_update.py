@@ -10,21 +10,11 @@ from bounce_gi.gpu_kernels.lpv import transfer_update
 from bounce_gi.gpu_kernels.lpv.settings import LpvSettings
 from bounce_gi.gpu_kernels.scene import Light, Material
 from bounce_gi.gpu_kernels.settings import RenderSettings
+from support.lpv_transfer import assert_same, indirect, rerun
 from support.synthetic import box_quads, quad_scene, room_with_box
 
 SETTINGS = RenderSettings("lpv", 48, 36, lpv=LpvSettings(resolution=16))
 
-
-def _indirect(result):
-    return result.passes["Diffuse Indirect"]
-
-
-def _rerun(result):
-    return [k for k, v in result.timings.items() if k != "total" and k not in result.skipped]
-
-
-def _same(a, b):
-    assert np.abs(a - b).max() <= 1e-5 * max(float(np.abs(b).mean()), 1e-12)
 
 
 def _slab_test(a: np.ndarray, b: np.ndarray, box: np.ndarray) -> np.ndarray:
@@ -85,13 +75,13 @@ def test_moving_an_object_updates_the_transfer_and_matches_a_render_from_scratch
     moved = engine.render(room_with_box(0.05), SETTINGS)
     print("box pairs (GPU, float64, differing, all):", tested)
     assert len(tested) == 1 and 0 < tested[0][1] < tested[0][3] and tested[0][2] <= 1e-3 * tested[0][1]
-    assert np.abs(_indirect(moved) - _indirect(before)).max() > 1e-3 * _indirect(before).mean()  # it did change
+    assert np.abs(indirect(moved) - indirect(before)).max() > 1e-3 * indirect(before).mean()  # it did change
     info = moved.info["cascades"][0]
     print("share of T re-evaluated:", info["transfer_updated"])
-    assert "lpv_transfer" in _rerun(moved) and 0 < info["transfer_updated"] < 0.5
+    assert "lpv_transfer" in rerun(moved) and 0 < info["transfer_updated"] < 0.5
     cold = Engine().render(room_with_box(0.05), SETTINGS)
     assert cold.info["cascades"][0]["block"] == info["block"]
-    _same(_indirect(moved), _indirect(cold))
+    assert_same(indirect(moved), indirect(cold))
 
 
 def test_lifting_a_turned_post_lists_the_pairs_near_its_ends_only(monkeypatch):
@@ -116,7 +106,7 @@ def test_lifting_a_turned_post_lists_the_pairs_near_its_ends_only(monkeypatch):
     moved = engine.render(room_with_box(0.05, size=0.3, height=1.2, turn=20.0), SETTINGS)
     print("boxes, pairs listed, pairs crossing one box around them:", listed)
     assert len(listed) == 1 and listed[0][0] > 1 and listed[0][1] <= 0.5 * listed[0][2]
-    _same(_indirect(moved), _indirect(Engine().render(room_with_box(0.05, size=0.3, height=1.2, turn=20.0),
+    assert_same(indirect(moved), indirect(Engine().render(room_with_box(0.05, size=0.3, height=1.2, turn=20.0),
                                                       SETTINGS)))
 
 
@@ -129,9 +119,9 @@ def test_an_edit_that_changes_most_of_the_transfer_builds_it_anew_without_updati
     engine = Engine()
     engine.render(room_with_box(0.0, size=1.2), SETTINGS)
     moved = engine.render(room_with_box(0.3, size=1.2), SETTINGS)
-    assert "lpv_transfer" in _rerun(moved) and moved.info["cascades"][0]["transfer_updated"] == 1.0
+    assert "lpv_transfer" in rerun(moved) and moved.info["cascades"][0]["transfer_updated"] == 1.0
     assert updates == [None] and evaluated == []  # an update was tried, and gave up before evaluating a pair
-    _same(_indirect(moved), _indirect(Engine().render(room_with_box(0.3, size=1.2), SETTINGS)))
+    assert_same(indirect(moved), indirect(Engine().render(room_with_box(0.3, size=1.2), SETTINGS)))
 
 
 def _room_with_plate(z):
@@ -152,5 +142,5 @@ def test_a_move_within_the_voxels_updates_the_pairs_it_moves():
     engine = Engine()
     engine.render(_room_with_plate(0.52), SETTINGS)
     moved = engine.render(_room_with_plate(0.53), SETTINGS)
-    assert "lpv_transfer" in _rerun(moved) and moved.info["cascades"][0]["transfer_updated"] < 1.0
-    _same(_indirect(moved), _indirect(Engine().render(_room_with_plate(0.53), SETTINGS)))
+    assert "lpv_transfer" in rerun(moved) and moved.info["cascades"][0]["transfer_updated"] < 1.0
+    assert_same(indirect(moved), indirect(Engine().render(_room_with_plate(0.53), SETTINGS)))

@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""The LPV's cached transfer (gpu_kernels/lpv/transfer.py) as the GPU tests read it: made by a render, and the
-one-bounce irradiance it gives when its clusters send a chosen flux."""
+"""The LPV's cached transfer (gpu_kernels/lpv/transfer.py) as the GPU tests read it: made by a render, the
+one-bounce irradiance it gives when its clusters send a chosen flux, and what a cached edit's render is compared
+by."""
 import numpy as np
 
 from bounce_gi.gpu_kernels.engine import Engine
@@ -23,3 +24,19 @@ def irradiance(t, flux) -> np.ndarray:
     c = t.clusters.count
     grey = np.repeat(np.asarray(flux, np.float64)[:, None], 3, axis=1)
     return solve(t, np.zeros((3, c, c)), grey, 1, 0.0)[0][..., 0].astype(np.float64)
+
+
+def indirect(result):
+    """A render's Diffuse Indirect pass."""
+    return result.passes["Diffuse Indirect"]
+
+
+def rerun(result) -> list:
+    """The passes a render ran (not taken from the cache)."""
+    return [k for k in result.timings if k != "total" and k not in result.skipped]
+
+
+def assert_same(a, b):
+    """A cached edit's image against a cold render's: the same float32 arithmetic on the same data, equal to the
+    rounding of sums of a few thousand terms, 1e-5 of the image's mean."""
+    assert np.abs(a - b).max() <= 1e-5 * max(float(np.abs(b).mean()), 1e-12)
