@@ -61,11 +61,11 @@ def render_direct_light(ctx, programs, gbuffer: GBuffer, shadows: ShadowAtlas, m
     """{"diffuse": Diffuse Direct (irradiance/π), "glossy": Glossy Direct} for every G-buffer pixel, (H, W, 3)
     float32 as gl/bind.read_texture gives a texture. `material_lut`: the materials' Principled table
     (direct/geometry.MaterialTextures.lut); None for G-buffers with no camera (the surface atlas), whose Glossy
-    Direct is 0. `sky`: the sky light's shares (direct/sky.render_sky_visibility's texture; None: computed here). The lights are lit
-    by groups (light_groups) and summed; "groups" keeps each group's images by key, and a group whose key `prior`
-    (an earlier output for the same G-buffer, shadow settings and material table) holds is not lit again ("relit":
-    the groups that were); with `relight` instead, an unchanged group is lit again where an object's move can
-    change it ("relit_pixels": the share of pixel × group runs that were)."""
+    Direct is 0. `sky`: the sky light's shares (direct/sky.render_sky_visibility's texture; None: computed here).
+    The lights are lit by groups (light_groups) and summed; "groups" keeps each group's images by key, and a group
+    whose key `prior` (an earlier output for the same G-buffer, shadow settings and material table) holds is not lit
+    again ("relit": the groups that were); with `relight` instead, an unchanged group is lit again where an object's
+    move can change it ("relit_pixels": the share of pixel × group runs that were)."""
     groups = light_groups(shadows)
     kept = prior["groups"] if prior is not None else {}
     images = {g.key: kept[g.key] if g.key in kept else None for g in groups}

@@ -139,7 +139,7 @@ class DepthAtlas:
     serial: int = field(default_factory=itertools.count().__next__)
     generation: int = 0
     redrawn: list = None
-    overwritten: KeptTexels = None  # the texels the last update's rectangles overwrote, in the views asked for
+    overwritten: KeptTexels = None  # the depths the last update's rectangles overwrote, and which of them changed
 
     def release(self):
         self.texture.release()

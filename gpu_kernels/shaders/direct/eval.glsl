@@ -54,6 +54,13 @@ vec2 gather_point(ShadowView v, vec2 atlas_uv) {
     return clamp(atlas_uv, v.tile.xy + 0.5 * u_atlas_texel, hi - 0.5 * u_atlas_texel);
 }
 
+// How far in front of `depth` the nearest of the four texels around atlas_uv lies (≤ 0: none does): the stored
+// depths compared as the atlas's "<=" comparison would.
+float gather_gap(ShadowView v, vec2 atlas_uv, float depth) {
+    vec4 z = textureGather(u_shadow_depth, gather_point(v, atlas_uv), 0);
+    return depth - min(min(z.x, z.y), min(z.z, z.w));
+}
+
 // max_slope caps the slope-scaled part of the offset (MAX_SLOPE for a light's own maps; 0 for the sky's many directions: a
 // grazing one pushed far off the surface would test a point beyond a thin wall, and acne in a few of them is
 // averaged away).
@@ -74,9 +81,8 @@ float view_test(int view_index, vec3 p, vec3 geo_n, vec3 to_light, float max_slo
     // texel alone can read the wall as behind p and let the sky in at its foot (a wall seen edge-on covers no
     // texel at all: only the dilation keeps the sky out along a zero-thickness wall parallel to a direction). It
     // darkens each direction's visible region by a texel on every side: a few percent under a skylight.
-    if (r == 0) {  // the stored depths compared here as the atlas's "<=" comparison would
-        vec4 z = textureGather(u_shadow_depth, gather_point(v, atlas_uv), 0);
-        gap = depth - min(min(z.x, z.y), min(z.z, z.w));
+    if (r == 0) {
+        gap = gather_gap(v, atlas_uv, depth);
         return gap <= 0.0 ? 1.0 : 0.0;
     }
     float sum = 0.0;

@@ -112,9 +112,8 @@ SkySums sky_sums_update(SkySums s, GpuLight L, vec3 p, vec3 n, vec3 geo_n, Gloss
         }
         float gap_old = depth - nearest;
         sky_count(s, view, w, gap_old <= 0.0 ? 1.0 : 0.0, gap_old, -1.0);
-        float gap;
-        float seen = view_test(view, p, geo_n, d, 0.0, gap);
-        sky_count(s, view, w, seen, gap, 1.0);
+        float gap = gather_gap(sv, atlas_uv, depth);   // view_test's, from the projection above
+        sky_count(s, view, w, gap <= 0.0 ? 1.0 : 0.0, gap, 1.0);
     }
     return s;
 }
