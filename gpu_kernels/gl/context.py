@@ -45,6 +45,15 @@ def create_context():
     raise GpuUnavailableError("could not create an OpenGL 4.3 context (" + "; ".join(errors) + ")")
 
 
+def share_cores(ctx) -> None:
+    """On a software renderer, numpy's BLAS on one thread: its spinning helpers would take the renderer's cores
+    (host_threads.py)."""
+    from .host_threads import is_software, limit_blas_threads
+
+    if is_software(ctx):
+        limit_blas_threads(1)
+
+
 class GpuWorker:
     """A daemon thread that owns the GL context and runs submitted jobs in order.
 
@@ -90,6 +99,7 @@ class GpuWorker:
             try:
                 if self._ctx is None:  # first job, or the first after drop_context: (re)try, so a cause gone is gone
                     self._ctx = self._factory()
+                    share_cores(self._ctx)
                 future.set_result(fn(self._ctx, *args, **kwargs))
             except BaseException as exc:
                 future.set_exception(exc)
