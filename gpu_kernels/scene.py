@@ -124,11 +124,19 @@ class Scene:
         return int(self.positions.shape[0])
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
-        """Axis-aligned world bounds of all triangles (min, max)."""
-        if self.triangle_count == 0:
-            return np.zeros(3), np.zeros(3)
-        p = self.positions.reshape(-1, 3)
-        return p.min(axis=0).astype(np.float64), p.max(axis=0).astype(np.float64)
+        """Axis-aligned world bounds of all triangles (min, max). Found once per positions array (kept beside the
+        fields, not in them: hashing and copies see only the fields): a render asks a dozen times (every light's
+        views, the grids, the memory check), each a pass over every corner. A scene's positions are replaced, not
+        changed in place, once it has been rendered."""
+        memo = self.__dict__.get("_bounds")
+        if memo is None or memo[0] is not self.positions:
+            if self.triangle_count == 0:
+                found = np.zeros(3), np.zeros(3)
+            else:
+                p = self.positions.reshape(-1, 3)
+                found = p.min(axis=0).astype(np.float64), p.max(axis=0).astype(np.float64)
+            memo = self.__dict__["_bounds"] = (self.positions, found)
+        return memo[1][0].copy(), memo[1][1].copy()
 
     def has_emission(self) -> bool:
         used = set(np.unique(self.material_index).tolist()) if self.triangle_count else set()
