@@ -14,6 +14,14 @@ from ..scene import Scene
 LUT_UNIT = 15  # the material table's texture unit: above every pass's own samplers (GL guarantees 16 units)
 
 
+# The vertex buffer's layout (upload_geometry: position, shading normal, UV, geometric normal, material index; 12
+# float32 per corner) as the moderngl formats of the attributes a program reads.
+POSITION_ONLY = "3f 36x"
+POSITION_UV = "3f 12x 2f 16x"
+SURFACE = "3f 3f 2f 3f 4x"              # in_position, in_normal, in_uv, in_geo_normal
+SURFACE_MATERIAL = "3f 3f 2f 3f 1f"     # the same and in_material
+
+
 @dataclass
 class GeometryBuffers:
     vbo: object
@@ -27,7 +35,8 @@ class GeometryBuffers:
 
 
 def upload_geometry(ctx, programs, scene: Scene) -> GeometryBuffers:
-    """Interleave corners (position, normal, uv, geometric normal) grouped by material into one VBO."""
+    """Interleave corners (position, normal, uv, geometric normal, material index) grouped by material into one
+    VBO."""
     order = np.argsort(scene.material_index, kind="stable")
     pos = scene.positions[order].astype(np.float32)
     nrm = scene.normals[order].astype(np.float32)
@@ -35,13 +44,14 @@ def upload_geometry(ctx, programs, scene: Scene) -> GeometryBuffers:
     geo = np.cross(pos[:, 1] - pos[:, 0], pos[:, 2] - pos[:, 0])
     geo /= np.maximum(np.linalg.norm(geo, axis=1, keepdims=True), 1e-30)
     geo = np.repeat(geo[:, None, :], 3, axis=1)
-    data = np.concatenate([pos, nrm, uvs, geo], axis=2).astype(np.float32)  # (T, 3, 11)
-    vbo = ctx.buffer(np.ascontiguousarray(data).tobytes() or b"\0" * 44)
+    mats = scene.material_index[order]
+    material = np.repeat(mats.astype(np.float32)[:, None, None], 3, axis=1)
+    data = np.concatenate([pos, nrm, uvs, geo, material], axis=2).astype(np.float32)  # (T, 3, 12)
+    vbo = ctx.buffer(np.ascontiguousarray(data).tobytes() or b"\0" * 48)
     gbuf = programs.raster("direct/gbuffer.glsl")
     depth = programs.raster("direct/shadow_depth.glsl")
-    vao_full = ctx.vertex_array(gbuf, [(vbo, "3f 3f 2f 3f", "in_position", "in_normal", "in_uv", "in_geo_normal")])
-    vao_depth = ctx.vertex_array(depth, [(vbo, "3f 32x", "in_position")])
-    mats = scene.material_index[order]
+    vao_full = ctx.vertex_array(gbuf, [(vbo, SURFACE, "in_position", "in_normal", "in_uv", "in_geo_normal")])
+    vao_depth = ctx.vertex_array(depth, [(vbo, POSITION_ONLY, "in_position")])
     ranges = []
     if len(mats):
         starts = np.flatnonzero(np.r_[True, mats[1:] != mats[:-1]])
@@ -142,14 +152,32 @@ def apply_binding(binding: tuple) -> None:
         texture.use(location=unit)
 
 
+def material_batches(scene: Scene, geometry: GeometryBuffers, textures: MaterialTextures) -> list:
+    """geometry.ranges merged into draws for a program that reads each vertex's material index (SURFACE_MATERIAL) and
+    of a material only its base colour texture: (material index, first vertex, vertex count), consecutive ranges of
+    materials without a texture drawn as one (under the first one's uniforms), a textured one alone. The same
+    triangles in the same order as draw_by_material draws them, in fewer calls: an RSM draws every shadow view (the
+    sky's 576, a lamp's cube) with a room's materials, and llvmpipe pays each call more than its few texels."""
+    out = []
+    for mat_index, first, count in geometry.ranges:
+        mat = scene.materials[mat_index] if 0 <= mat_index < len(scene.materials) else None
+        textured = bool(mat and 0 <= mat.base_color_texture < len(textures))
+        if out and not textured and not out[-1][3] and out[-1][1] + out[-1][2] == first:
+            out[-1] = (out[-1][0], out[-1][1], out[-1][2] + count, False)
+        else:
+            out.append((mat_index, first, count, textured))
+    return [(m, first, count) for m, first, count, _ in out]
+
+
 def draw_by_material(prog, scene: Scene, geometry: GeometryBuffers, textures: list, vao=None,
-                     bindings: dict | None = None) -> None:
-    """Draw the geometry one material range at a time with that material's uniforms (common/materials.glsl).
-    `bindings`: material index → material_binding for `prog`, made once for many draws (made here if None)."""
+                     bindings: dict | None = None, batches: list | None = None) -> None:
+    """Draw the geometry one material range at a time with that material's uniforms (common/materials.glsl), or
+    (`batches`, material_batches) a draw per batch. `bindings`: material index → material_binding for `prog`, made
+    once for many draws (made here if None)."""
     import moderngl
 
     vao = vao or geometry.vao_full
-    for mat_index, first, count in geometry.ranges:
+    for mat_index, first, count in geometry.ranges if batches is None else batches:
         apply_binding(bindings[mat_index] if bindings is not None else
                       material_binding(prog, scene, mat_index, textures))
         vao.render(moderngl.TRIANGLES, vertices=count, first=first)

@@ -10,7 +10,7 @@ import numpy as np
 
 from ..common import atlas
 from ..common import lights as lb
-from ..direct.geometry import draw_by_material, material_binding
+from ..direct.geometry import SURFACE_MATERIAL, draw_by_material, material_batches, material_binding
 from ..direct.shadows import redraw_plan
 from ..gl.bind import set_uniform, ssbo, write_uniform
 from ..scene import Scene
@@ -119,7 +119,8 @@ def render_rsm(ctx, programs, scene: Scene, geometry, textures, shadows, resolut
     ctx.enable(moderngl.DEPTH_TEST)
     ctx.disable(moderngl.CULL_FACE)
     prog = programs.raster("lpv/rsm.glsl")
-    bindings = {m: material_binding(prog, scene, m, textures) for m, _, _ in geometry.ranges}
+    batches = material_batches(scene, geometry, textures)  # the material index comes from each vertex
+    bindings = {m: material_binding(prog, scene, m, textures) for m, _, _ in batches}
     records = np.zeros(len(views), RSM_VIEW_DTYPE)
     for i, (view, (x, y, w, h)) in enumerate(zip(views, tiles)):
         _view_record(records[i], view, view_lights[i], buffers.lights[view_lights[i]], i, w)
@@ -136,7 +137,7 @@ def render_rsm(ctx, programs, scene: Scene, geometry, textures, shadows, resolut
         set_uniform(prog, "u_ortho", bool(view.ortho))
         set_uniform(prog, "u_far", 0.0 if view.ortho else float(view.far))
         set_uniform(prog, "u_view_index", float(i))
-        draw_by_material(prog, scene, geometry, textures, vao=out.vao, bindings=bindings)
+        draw_by_material(prog, scene, geometry, textures, vao=out.vao, bindings=bindings, batches=batches)
     ctx.scissor = None
     if out.views_ssbo is not None and out.views_ssbo.size == records.nbytes:
         out.views_ssbo.write(records.tobytes())
@@ -167,7 +168,8 @@ def _new_rsm(ctx, programs, geometry, size: tuple, resolution: int) -> Rsm:
 def _vertex_array(ctx, programs, geometry):
     """The VAO lpv/rsm.glsl draws `geometry`'s vertex buffer with."""
     prog = programs.raster("lpv/rsm.glsl")
-    return ctx.vertex_array(prog, [(geometry.vbo, "3f 3f 2f 3f", "in_position", "in_normal", "in_uv", "in_geo_normal")])
+    return ctx.vertex_array(prog, [(geometry.vbo, SURFACE_MATERIAL, "in_position", "in_normal", "in_uv",
+                                    "in_geo_normal", "in_material")])
 
 
 def _view_record(record, view, light: int, light_record, index: int, w: int) -> None:

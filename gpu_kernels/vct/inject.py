@@ -11,7 +11,7 @@ import math
 import numpy as np
 
 from ..common.lights import SKY_INJECTION_STRIDE
-from ..direct.geometry import draw_by_material
+from ..direct.geometry import POSITION_ONLY, POSITION_UV, draw_by_material
 from ..gl.bind import (bind_grid, bind_lights, bind_samplers, dispatch, set_uniform, set_uniforms, texture3d,
                        zero_texture)
 from ..scene import Scene
@@ -104,8 +104,8 @@ def _rasterise(ctx, prog, scene, geometry, textures, side: int) -> None:
     """Draw every triangle through `prog` into an empty side × side framebuffer (the image stores are the output)."""
     import moderngl
 
-    layout = [(geometry.vbo, "3f 12x 2f 12x", "in_position", "in_uv")] if "in_uv" in prog else \
-        [(geometry.vbo, "3f 32x", "in_position")]  # the front-most pass samples no texture
+    layout = [(geometry.vbo, POSITION_UV, "in_position", "in_uv")] if "in_uv" in prog else \
+        [(geometry.vbo, POSITION_ONLY, "in_position")]  # the front-most pass samples no texture
     vao = ctx.vertex_array(prog, layout)
     fbo = ctx.empty_framebuffer((side, side))
     try:

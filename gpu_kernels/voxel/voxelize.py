@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..common.grid import Grid
-from ..direct.geometry import bind_material
+from ..direct.geometry import POSITION_ONLY, POSITION_UV, bind_material
 from ..gl.bind import bind_named, dispatch, set_uniform, set_uniforms, zero_texture
 from ..scene import Scene
 from .tessellate import draw_tessellated, patch_buffers
@@ -320,8 +320,8 @@ def _draw_raster(ctx, programs, scene, geometry, textures, grid, supersample, un
     set_uniforms(prog, {**uniforms, "u_viewport": (float(side), float(side)), "u_dilation": DILATION_PX,
                         "u_supersample_i": supersample})
     fbo = ctx.empty_framebuffer((side, side))
-    layout = (geometry.vbo, "3f 12x 2f 12x", "in_position", "in_uv") if "in_uv" in prog else \
-        (geometry.vbo, "3f 32x", "in_position")  # MODE_FRONT samples no texture
+    layout = (geometry.vbo, POSITION_UV, "in_position", "in_uv") if "in_uv" in prog else \
+        (geometry.vbo, POSITION_ONLY, "in_position")  # MODE_FRONT samples no texture
     vao = ctx.vertex_array(prog, [layout])
     try:
         fbo.use()

@@ -7,6 +7,10 @@ layout(location = 1) in vec3 in_normal;
 layout(location = 2) in vec2 in_uv;
 layout(location = 3) in vec3 in_geo_normal;
 uniform mat4 u_view_projection;
+#if defined(VERTEX_MATERIAL)
+layout(location = 4) in float in_material;   // the triangle's material index (direct/geometry.SURFACE_MATERIAL)
+flat out float v_material;
+#endif
 out vec3 v_position;
 out vec3 v_normal;
 out vec2 v_uv;
@@ -16,5 +20,8 @@ void main() {
     v_normal = in_normal;
     v_uv = in_uv;
     v_geo_normal = in_geo_normal;
+#if defined(VERTEX_MATERIAL)
+    v_material = in_material;
+#endif
     gl_Position = u_view_projection * vec4(in_position, 1.0);
 }

@@ -4,6 +4,9 @@
 // injection needs to compute their albedo (lpv/inject.glsl texel_albedo): the texture's colour where the material
 // has one (else 1) and the material's index. Not the albedo itself: the RSM then holds no material colour, so a
 // colour edit redraws no view, and the injection re-bins only the light the edited material's texels reflect.
+// The material index comes with each vertex, so one draw spans every material without a texture
+// (direct/geometry.material_batches); a textured one is drawn alone, with its texture bound.
+#define VERTEX_MATERIAL
 #if defined(VERTEX_SHADER)
 #include "common/surface_vertex.glsl"
 #endif
@@ -14,6 +17,7 @@ in vec3 v_position;
 in vec3 v_normal;
 in vec2 v_uv;
 in vec3 v_geo_normal;
+flat in float v_material;
 uniform vec3 u_origin;       // the view's eye (perspective)
 uniform vec3 u_forward;      // the view's axis (orthographic: the sun's direction)
 uniform bool u_ortho;
@@ -36,6 +40,6 @@ void main() {
     gl_FragDepth = u_far > 0.0 ? length(v_position - u_origin) / u_far : gl_FragCoord.z;
     out_position = vec4(v_position, u_view_index + 1.0);
     out_normal = vec4(n, max(dot(n, to_light), 0.0));
-    out_albedo = vec4(u_use_texture ? texture(u_base_texture, v_uv).rgb : vec3(1.0), float(u_material));
+    out_albedo = vec4(u_use_texture ? texture(u_base_texture, v_uv).rgb : vec3(1.0), v_material);
 }
 #endif
