@@ -73,7 +73,7 @@ def render_direct_light(ctx, programs, gbuffer: GBuffer, shadows: ShadowAtlas, m
     masks = _relight_masks(shadows, todo, relight)
     if todo:
         textures = [ctx.texture(gbuffer.size, 4, dtype="f4") for _ in range(2)]
-        prog = programs.compute("direct/light.glsl")
+        prog = programs.compute("direct/light.glsl", shadows.defines)
         unit_records = shadows.buffers.lights.copy()
         unit_records["color_type"][:, :3] = 1.0
         unit_ssbo = ssbo(ctx, unit_records)

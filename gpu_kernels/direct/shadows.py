@@ -33,6 +33,14 @@ class ShadowAtlas:
     maps: object = None  # the DepthAtlas `depth` belongs to (its serial, generation and last redraw)
     _raw: object = None
 
+    @property
+    def defines(self) -> dict:
+        """Defines for a program that evaluates these lights (common/light_eval.glsl): NO_TRIANGLE_LISTS where none
+        is an emitter's triangle list (the scene has no emissive mesh), which leaves that code out of the program."""
+        lights = self.buffers.lights
+        lists = (lights["color_type"][:, 3] == lb.LIGHT_POLYGON) & (lights["polygon"][:, 3] > 0.5)
+        return {} if np.any(lists) else {"NO_TRIANGLE_LISTS": None}
+
     def raw_depth(self):
         """A sampler reading `depth`'s values without comparison, nearest (made on first use)."""
         import moderngl

@@ -61,7 +61,7 @@ def render_sky_visibility(ctx, programs, gbuffer: GBuffer, shadows: ShadowAtlas,
         return None
     w, h = gbuffer.size
     shares, sums, blocked = (ctx.texture((w, h), 4, dtype="f4") for _ in range(3))
-    prog = programs.compute("direct/light.glsl", {"MODE_SKY": None})
+    prog = programs.compute("direct/light.glsl", {"MODE_SKY": None, **shadows.defines})
     for binding, tex in ((2, shares), (3, sums), (4, blocked)):
         tex.bind_to_image(binding, read=False, write=True)
     unit = bind_inputs(prog, gbuffer, shadows, material_lut)

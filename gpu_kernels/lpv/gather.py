@@ -137,7 +137,8 @@ def rsm_records(ctx, programs, rsm, shadows, materials, grid: Grid, budget: int,
     slots): each record's slot in the whole atlas's list, 2 × (block row × blocks per row + block column) + its
     plane, the order a run over the whole atlas lists them in (merge_records)."""
     k = block_size(rsm, PRECLUSTER * budget if limit is None else limit)
-    prog = programs.compute("lpv/inject.glsl", {"MODE_LIST": 1, **({"BLOCK_LIST": 1} if blocks is not None else {})})
+    prog = programs.compute("lpv/inject.glsl", {"MODE_LIST": 1, **({"BLOCK_LIST": 1} if blocks is not None else {}),
+                                                **shadows.defines})
     bind_grid(prog, grid)
     set_uniform(prog, "u_unit_color", bool(unit_color))
     set_uniform(prog, "u_masked", lights is not None)

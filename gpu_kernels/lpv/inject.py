@@ -14,7 +14,7 @@ def inject(ctx, programs, rsm: Rsm, shadows, materials, state: LpvGridState, dow
     """RSM texels → fixed-point SH sums → state.injected. Returns the injected flux (W, sum of RGB)."""
     scale = FIXED_RANGE / max(flux_bound(shadows.buffers), 1e-30)
     state.accum_ints.clear()
-    prog = programs.compute("lpv/inject.glsl")
+    prog = programs.compute("lpv/inject.glsl", shadows.defines)
     blocks = rsm_uniforms(prog, rsm, shadows, materials, downsample)
     set_uniform(prog, "u_fixed_scale", float(scale))
     bind_grid(prog, state.grid)

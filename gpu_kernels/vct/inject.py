@@ -45,7 +45,7 @@ def inject(ctx, programs, scene: Scene, geometry, textures: list, vox, shadows, 
         try:
             # The front-most surfaces first (MODE_FRONT), then the injection that leaves covered ones out.
             for defines in (({"MODE_FRONT": None},) if fronts else ()) + ({},):
-                prog = programs.raster("vct/inject_raster.glsl", defines)
+                prog = programs.raster("vct/inject_raster.glsl", {**defines, **shadows.defines})
                 bind_grid(prog, grid, 1)
                 bind_lights(prog, shadows, unit=2, sky_stride=SKY_INJECTION_STRIDE)
                 set_uniforms(prog, {"u_samples": float(INJECT_SAMPLES), "u_viewport": (float(side), float(side)),
@@ -60,7 +60,7 @@ def inject(ctx, programs, scene: Scene, geometry, textures: list, vox, shadows, 
                 t.release()
 
         for outputs, defines in ((faces.textures, {}), (faces.centroids, {"WRITE_CENTROIDS": None})):
-            prog = programs.compute("vct/inject.glsl", {"MODE_RESOLVE": None, **defines})
+            prog = programs.compute("vct/inject.glsl", {"MODE_RESOLVE": None, **defines, **shadows.defines})
             unit = bind_samplers(prog, "u_area", [vox.area], 0)
             unit = bind_samplers(prog, "u_albedo", [vox.albedo], unit)
             unit = bind_samplers(prog, "u_normal", [vox.normal], unit)

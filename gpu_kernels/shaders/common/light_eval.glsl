@@ -58,23 +58,31 @@ float polygon_projected_solid_angle(int first, int count, vec3 p, vec3 n) {
 // vertices, or an emitter cluster's list; `scale` is the triangle's radiance relative to color_type.rgb (rgb) and
 // 1 where it emits along its winding normal (b − a) × (c − a) only (w: a closed emitter's, common/emitters.py). For
 // code that integrates something other than the cosine over the light (a glossy lobe).
+// NO_TRIANGLE_LISTS (common/lights.shader_defines: the scene has no emissive mesh) leaves the triangle lists' code
+// out of the program: unused, it still made llvmpipe run an area light's RSM texels 2.5× as long.
 int polygon_triangle_count(GpuLight L) {
+#if defined(NO_TRIANGLE_LISTS)
+    return max(int(L.polygon.y) - 2, 0);
+#else
     return L.polygon.w > 0.5 ? int(L.polygon.y) / 4 : max(int(L.polygon.y) - 2, 0);
+#endif
 }
 
 void polygon_triangle(GpuLight L, int t, out vec3 a, out vec3 b, out vec3 c, out vec4 scale) {
     int first = int(L.polygon.x);
+#if !defined(NO_TRIANGLE_LISTS)
     if (L.polygon.w > 0.5) {
         a = polygon_vertices[first + 4 * t].xyz;
         b = polygon_vertices[first + 4 * t + 1].xyz;
         c = polygon_vertices[first + 4 * t + 2].xyz;
         scale = polygon_vertices[first + 4 * t + 3];
-    } else {
-        a = polygon_vertices[first].xyz;
-        b = polygon_vertices[first + t + 1].xyz;
-        c = polygon_vertices[first + t + 2].xyz;
-        scale = vec4(1.0, 1.0, 1.0, 0.0);
+        return;
     }
+#endif
+    a = polygon_vertices[first].xyz;
+    b = polygon_vertices[first + t + 1].xyz;
+    c = polygon_vertices[first + t + 2].xyz;
+    scale = vec4(1.0, 1.0, 1.0, 0.0);
 }
 
 // A polygon light's ∫ (radiance / color) cosθ dω at p: its polygon's projected solid angle, or for a triangle list
@@ -87,6 +95,9 @@ void polygon_triangle(GpuLight L, int t, out vec3 a, out vec3 b, out vec3 c, out
 #define SELF_PLANE 1e-2
 vec3 polygon_light_solid_angle(GpuLight L, vec3 p, vec3 n) {
     int first = int(L.polygon.x), count = int(L.polygon.y);
+#if defined(NO_TRIANGLE_LISTS)
+    return vec3(polygon_projected_solid_angle(first, count, p, n));
+#else
     if (L.polygon.w < 0.5) return vec3(polygon_projected_solid_angle(first, count, p, n));
     vec3 sum = vec3(0.0);
     for (int i = first; i < first + count; i += 4) {
@@ -103,5 +114,6 @@ vec3 polygon_light_solid_angle(GpuLight L, vec3 p, vec3 n) {
         sum += triangle_projected_solid_angle(a, b, c, n) * scale.rgb;
     }
     return sum;
+#endif
 }
 
