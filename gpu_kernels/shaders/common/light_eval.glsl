@@ -58,8 +58,8 @@ float polygon_projected_solid_angle(int first, int count, vec3 p, vec3 n) {
 // vertices, or an emitter cluster's list; `scale` is the triangle's radiance relative to color_type.rgb (rgb) and
 // 1 where it emits along its winding normal (b − a) × (c − a) only (w: a closed emitter's, common/emitters.py). For
 // code that integrates something other than the cosine over the light (a glossy lobe).
-// NO_TRIANGLE_LISTS (direct/shadows.ShadowAtlas.defines: the scene has no emissive mesh) leaves the triangle lists' code
-// out of the program: unused, it still made llvmpipe run an area light's RSM texels about twice as long.
+// NO_TRIANGLE_LISTS (direct/shadows.ShadowAtlas.defines: the scene has no emissive mesh) leaves the triangle
+// lists' code out of the program: unused, it still made llvmpipe run an area light's RSM texels about twice as long.
 int polygon_triangle_count(GpuLight L) {
 #if defined(NO_TRIANGLE_LISTS)
     return max(int(L.polygon.y) - 2, 0);
