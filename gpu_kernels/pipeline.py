@@ -243,8 +243,7 @@ class Pipeline:
         or light colour edit and another light's move skip it. `camera`: the G-buffer is the camera's (an object's
         move then re-lights only the pixels it can change: _relight, _sky_update)."""
         maps, scene = frame.shadows.maps, frame.scene
-        made_from = (maps.serial, maps.generation, (scene.positions, scene.normals, scene.uvs, scene.material_index),
-                     frame.keys["gbuffer"])
+        made_from = (maps.serial, maps.generation, scene.surface_arrays(), frame.keys["gbuffer"])
         k_sky = (frame.keys["direct"][0], sh.sky_key(frame.shadows))
 
         def sky_visibility():
@@ -274,7 +273,7 @@ class Pipeline:
         if maps.redrawn is None or (serial, generation + 1) != (maps.serial, maps.generation) \
                 or gbuffer_key[1:] != keys["gbuffer"][1:]:
             return None
-        box = sh.moved_box(surfaces, (scene.positions, scene.normals, scene.uvs, scene.material_index))
+        box = sh.moved_box(surfaces, scene.surface_arrays())
         if box is False:
             return None
         w, h = frame.gbuffer.size
@@ -308,7 +307,7 @@ class Pipeline:
         """The passes every method shares, up to the G-buffer and the shadow maps, and the keys they ran under.
         The G-buffer is the camera's, or with `samples` that of surface points (render_surface, render_points)."""
         ctx, programs, cache = self.ctx, self.programs, self.cache
-        keys = {"geometry": hash_parts(scene.positions, scene.normals, scene.uvs, scene.material_index),
+        keys = {"geometry": hash_parts(*scene.surface_arrays()),
                 **material_keys(scene), "lights": hash_parts(scene.lights),
                 "camera": hash_parts(scene.camera, scene.pixel_aspect, settings.width, settings.height)
                 if samples is None else samples.key,

@@ -138,6 +138,11 @@ class Scene:
             memo = self.__dict__["_bounds"] = (self.positions, found)
         return memo[1][0].copy(), memo[1][1].copy()
 
+    def surface_arrays(self) -> tuple:
+        """What a rasterised surface is made of: positions, normals, UVs and material indices (the geometry's key;
+        what a kept map or output records it was drawn from, direct/shadows.moved_box)."""
+        return self.positions, self.normals, self.uvs, self.material_index
+
     def has_emission(self) -> bool:
         used = set(np.unique(self.material_index).tolist()) if self.triangle_count else set()
         return any(max(self.materials[i].emission) > 0 for i in used if 0 <= i < len(self.materials))

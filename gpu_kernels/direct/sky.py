@@ -47,9 +47,11 @@ class SkyUpdate:
     texels: object
 
 
-def has_sky(shadows: ShadowAtlas) -> bool:
-    """Whether the scene's lights include the sky (the world as a light)."""
-    return any(int(t) == lb.LIGHT_SKY for t in shadows.buffers.lights["color_type"][:, 3])
+def sky_light(shadows: ShadowAtlas) -> int | None:
+    """The index of the sky light (the world as a light) among the light records, None where there is none."""
+    kinds = shadows.buffers.lights["color_type"][:, 3].astype(int)
+    found = np.nonzero(kinds == lb.LIGHT_SKY)[0]
+    return int(found[0]) if len(found) else None
 
 
 def render_sky_visibility(ctx, programs, gbuffer: GBuffer, shadows: ShadowAtlas, material_lut=None,
@@ -57,7 +59,7 @@ def render_sky_visibility(ctx, programs, gbuffer: GBuffer, shadows: ShadowAtlas,
     """The sky light's SkyShares, or None where the scene has no sky light. With `update`, a pixel outside its
     moved rectangle takes its earlier sums and does again only the tests that read a texel the move redrew: the
     same sums as testing every direction, to float32 rounding (tests/gpu/test_sky_update.py)."""
-    if not has_sky(shadows):
+    if sky_light(shadows) is None:
         return None
     w, h = gbuffer.size
     shares, sums, blocked = (ctx.texture((w, h), 4, dtype="f4") for _ in range(3))
@@ -82,7 +84,6 @@ def render_sky_visibility(ctx, programs, gbuffer: GBuffer, shadows: ShadowAtlas,
     for buffer in buffers:
         buffer.release()
     return SkyShares(filter_sky_shares(ctx, programs, gbuffer, shares), sums, blocked)
-
 
 
 def tile_boxes(gbuffer: GBuffer, moved: tuple) -> np.ndarray:
@@ -114,7 +115,7 @@ def tile_directions(ctx, programs, gbuffer: GBuffer, shadows: ShadowAtlas, updat
     out = ctx.buffer(reserve=4 * tiles * words)
     prog = programs.compute("direct/sky_tiles.glsl")
     bind_light_records(shadows)
-    sky = next(i for i, t in enumerate(shadows.buffers.lights["color_type"][:, 3]) if int(t) == lb.LIGHT_SKY)
+    sky = sky_light(shadows)
     set_uniforms(prog, {"u_first_view": int(shadows.buffers.lights[sky]["params"][1]), "u_tiles": tiles,
                         "u_directions": len(update.table), "u_words": words,
                         "u_atlas_texel": (1.0 / shadows.size[0], 1.0 / shadows.size[1])})
@@ -132,11 +133,10 @@ def update_table(shadows: ShadowAtlas) -> np.ndarray | None:
     maps = shadows.maps
     if maps is None or maps.redrawn is None or maps.overwritten is None:
         return None
-    kinds = shadows.buffers.lights["color_type"][:, 3].astype(int)
-    sky = [i for i, kind in enumerate(kinds) if kind == lb.LIGHT_SKY]
-    if len(sky) != 1:
+    sky = sky_light(shadows)
+    if sky is None:
         return None
-    first, count = (int(v) for v in shadows.buffers.lights[sky[0]]["params"][1:3])
+    first, count = (int(v) for v in shadows.buffers.lights[sky]["params"][1:3])
     table = np.zeros((count, 2, 4), np.int32)
     kept, changed = maps.overwritten.rects, maps.overwritten.changed
     for view, rect in maps.redrawn:

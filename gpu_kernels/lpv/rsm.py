@@ -106,7 +106,7 @@ def render_rsm(ctx, programs, scene: Scene, geometry, textures, shadows, resolut
            for v, light in zip(views, view_lights)]
     tiles, size, scale = atlas.allocate_atlas(res, max_height=ctx.info.get("GL_MAX_TEXTURE_SIZE", 16384))
     tiles, size, rows = [tuple(t) for t in tiles], tuple(size), shadows.rows
-    surfaces = (scene.positions, scene.normals, scene.uvs, scene.material_index)  # what its texels hold
+    surfaces = scene.surface_arrays()  # what its texels hold
     plan = redraw_plan(prior, views, tiles, size, rows, surfaces)
     out = prior if plan is not None else _new_rsm(ctx, programs, geometry, size, resolution // scale)
     if out.geometry is not geometry:  # the geometry's buffers were made again: draw from the new ones
