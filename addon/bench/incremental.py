@@ -19,6 +19,9 @@ from ..scene_io import load_scene
 KINDS = ("full", "unchanged", "camera_only", "light_move", "light_power", "material_change", "world_change",
          "object_move")
 STEP = 0.05  # metres (or colour units) per edit: small enough to stay a "typical" interactive nudge
+# An object's move per edit as a share of the scene's size, where that is less than STEP: in a scene 10 cm across
+# (product_shot) 5 cm steps lifted a coin out of the scene, which changes the grids (a new frame, not a nudge).
+NUDGE = 0.025
 # The targets (fractions of `full`) an edit is held to, and the speed-up over Cycles 1 spp + OIDN of a light move.
 TARGETS = {"unchanged": 0.01, "camera_only": 0.25, "light_move": 0.10, "light_power": 0.10, "material_change": 0.10,
            "world_change": 0.10, "object_move": 0.40}
@@ -57,6 +60,15 @@ def _colour_values(material):
     if socket is not None:
         return socket.default_value
     return None if material.use_nodes and material.node_tree else material.diffuse_color
+
+
+def _extent(objects) -> float:
+    """The largest side of the box around `objects`' world-space bounding boxes (m)."""
+    import numpy as np
+
+    corners = np.concatenate([np.c_[np.array(o.bound_box), np.ones(8)] @ np.array(o.matrix_world).T
+                              for o in objects])[:, :3]
+    return float((corners.max(axis=0) - corners.min(axis=0)).max())
 
 
 def _stepper(get, put, value_at):
@@ -102,8 +114,8 @@ def _edits(bpy):
     lights = [o for o in scene.objects if o.type == "LIGHT" and o.visible_get()]
     edits = {}
 
-    def mover(obj, axis):
-        return _stepper(*_channel(obj.location, axis), lambda base, k: base + k * STEP)
+    def mover(obj, axis, step=STEP):
+        return _stepper(*_channel(obj.location, axis), lambda base, k: base + k * step)
 
     edits["camera_only"] = mover(scene.camera, 0) if scene.camera else "the scene has no camera"
     edits["light_move"] = mover(lights[0], 0) if lights else "the scene has no light object (emission only)"
@@ -117,7 +129,7 @@ def _edits(bpy):
     if meshes:
         # the smallest object: moving a wall of a room would be an unusual edit
         smallest = min(meshes, key=lambda o: max(o.dimensions))
-        edits["object_move"] = mover(smallest, 2)
+        edits["object_move"] = mover(smallest, 2, min(STEP, NUDGE * _extent(meshes)))
     else:
         edits["object_move"] = "the scene has no mesh object"
     # the first material whose base colour is a value (an image's colour is no nudge: editing it changed nothing)

@@ -82,6 +82,19 @@ class PassCache:
         of starting over (the depth atlas, the RSM, the first bounce, Diffuse Direct after a light edit)."""
         return next((value for key, value in self.kept(name) if match(key)), None)
 
+    def spare(self, name: str, besides=None) -> object:
+        """The output that storing a new one of `name` would release (the oldest kept, once `keep[name]` are kept),
+        taken out of the cache and handed to the caller, who may write the new output into its memory and releases
+        the rest of it; None where none would go, or where that one `is besides` (the prior the new output is made
+        from). Writing into memory already in use spares the kernel's page faults: a new 100 MB array cost more to
+        touch the first time than the copy into it (the LPV's transfer after a geometry edit)."""
+        older = self.older.get(name, [])
+        if name not in self.entries or not older or len(older) < self.keep.get(name, 1) - 1:
+            return None
+        if older[-1].value is besides:
+            return None
+        return older.pop().value
+
     def _retire(self, name: str, entry) -> None:
         """Keep a replaced output among the `keep[name] - 1` older ones, releasing what falls off the end."""
         if entry is None:

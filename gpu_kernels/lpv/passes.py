@@ -294,8 +294,12 @@ def _transfer_geometry(frame, grids, k_grids, budget) -> tuple:
     k_tr = (k_gv, budget, s.occlusion)
     # A kept T of the same grids (k_gv's grid keys), budget and occlusion, made before a geometry edit.
     priors = cache.prior("lpv_transfer", lambda key: key[1:] == k_tr[1:] and key[0][1] == k_gv[1]) or [None] * len(gvs)
-    transfers = cache.run("lpv_transfer", k_tr, lambda: [_build(ctx, programs, gv, grid, budget, s, p)
-                                                         for gv, grid, p in zip(gvs, grids, priors)])
+    def build():  # written into the memory of the T this one evicts, where it fits (PassCache.spare)
+        spares = list(cache.spare("lpv_transfer", besides=priors) or [])
+        spares += [None] * (len(gvs) - len(spares))
+        return [_build(ctx, programs, gv, grid, budget, s, p, getattr(spare, "matrix", None))
+                for gv, grid, p, spare in zip(gvs, grids, priors, spares)]
+    transfers = cache.run("lpv_transfer", k_tr, build)
     weights = [a * gv.surface_area[None, :, None] for a, gv in zip(albedo, gvs)]  # (2, R, 3) per side
     k_m = (k_tr, k_albedo)
     # M_ρ kept in float32: the bounce series reads it once a bounce, and in float64 a light's move spent 19 ms of
@@ -318,11 +322,11 @@ def skipped_work(stats: list, s) -> list:
     return out
 
 
-def _build(ctx, programs, gv, grid, budget, s, prior=None) -> transfer.Transfer:
+def _build(ctx, programs, gv, grid, budget, s, prior=None, spare=None) -> transfer.Transfer:
     """Clusters and T of one cascade: updated from `prior` (the same grid before a geometry edit) where that
     re-evaluates under half of T (lpv/transfer_update.py), else made anew with the budget re-checked against the
-    real surface-voxel count."""
-    updated = transfer_update.update_transfer(ctx, programs, gv, grid, s.occlusion, prior) \
+    real surface-voxel count; T in `spare`'s memory where it fits (transfer.empty_matrix)."""
+    updated = transfer_update.update_transfer(ctx, programs, gv, grid, s.occlusion, prior, spare=spare) \
         if prior is not None and prior.grid == grid else None
     if updated is not None:
         return updated
@@ -331,7 +335,7 @@ def _build(ctx, programs, gv, grid, budget, s, prior=None) -> transfer.Transfer:
                                      max(transfer.MIN_CLUSTERS, min(budget, fits)), positions=gv.positions,
                                      bounds=gv.bounds)
     matrix = transfer.build_transfer(ctx, programs, gv, grid, sources, s.occlusion)
-    return transfer.sort_by_cluster(sources, matrix, gv, grid)
+    return transfer.sort_by_cluster(sources, matrix, gv, grid, spare)
 
 
 def _solve(ctx, programs, gvs, grids, transfers, reflection, sources, s) -> dict:

@@ -19,7 +19,7 @@ from ..common.grid import Grid
 from ..gl.bind import set_uniform
 from . import crossings
 from .clusters import Clusters, make_clusters
-from .transfer import cluster_order, dispatch_in_runs, kernel_program, receiver_rows, sorted_transfer
+from .transfer import cluster_order, dispatch_in_runs, empty_matrix, kernel_program, receiver_rows, sorted_transfer
 
 PAIRS_PER_DISPATCH = 1 << 20  # pairs evaluated per dispatch and listed at a time: 8 MiB read back, 16384 groups
 # box_pairs' invocations per dispatch: one per source and word of 32 receivers (the most work groups of 64 a
@@ -39,9 +39,10 @@ NORMAL_TOLERANCE = 1e-5
 EXTENT_TOLERANCE = 1e-4
 
 
-def update_transfer(ctx, programs, gv, grid: Grid, occlusion: bool, prior, limit: float = 0.5):
-    """The Transfer after a geometry edit, from `prior` (the one before it); None where the share of pairs to
-    evaluate would reach `limit` (build T anew instead)."""
+def update_transfer(ctx, programs, gv, grid: Grid, occlusion: bool, prior, limit: float = 0.5, spare=None):
+    """The Transfer after a geometry edit, from `prior` (the one before it), its T written into `spare`'s memory
+    where it fits (transfer.empty_matrix); None where the share of pairs to evaluate would reach `limit` (build T
+    anew instead)."""
     new = make_clusters(gv.cells, gv.surface_normal, gv.surface_area, gv.fine, 0, block=prior.clusters.block,
                         positions=gv.positions, bounds=gv.bounds, detached=prior.clusters.detached)
     before, after = prior.rows, receiver_rows(gv)
@@ -60,7 +61,7 @@ def update_transfer(ctx, programs, gv, grid: Grid, occlusion: bool, prior, limit
         return None
     order, starts = cluster_order(new)
     columns = []
-    matrix = np.empty((2, new.count, int(gv.surface_count)), np.float32)
+    matrix = empty_matrix((2, new.count, int(gv.surface_count)), spare)
     for side in range(2):  # columns in the new clusters' order: the kept pairs' old values, then the fresh ones
         old_column = np.empty(len(prior.order[side]), np.int64)
         old_column[prior.order[side]] = np.arange(len(old_column))
@@ -69,7 +70,7 @@ def update_transfer(ctx, programs, gv, grid: Grid, occlusion: bool, prior, limit
         take_columns(prior.matrix[side], old_column[np.maximum(old_r[order[side]], 0)], matrix[side],
                      rows=np.maximum(old_c, 0))
     for first, last in source_chunks(per_source, PAIRS_PER_DISPATCH):  # the pair lists a chunk at a time
-        sources, receivers = np.nonzero(fresh[first:last])
+        sources, receivers = np.divmod(np.flatnonzero(fresh[first:last]), fresh.shape[1])  # 4× a 2-D np.nonzero
         sources += first
         values = evaluate_pairs(ctx, programs, gv, grid, new, occlusion, sources, receivers)
         for side in range(2):
@@ -93,19 +94,13 @@ def source_chunks(counts: np.ndarray, most: int) -> list:
 
 
 def take_columns(src: np.ndarray, columns: np.ndarray, out: np.ndarray, rows: np.ndarray | None = None) -> None:
-    """out[:, k] = src[rows][:, columns[k]] (`rows`: all of them where None), each run of consecutive columns copied
-    as one block, rows and columns at once: an update's columns are the kept clusters' receivers in the order they
-    had, a few hundred runs, where a column-by-column gather (np.take) cost 0.1 s a side in the furnished room, and
-    gathering the rows first copied T once more."""
-    if len(columns) == 0:
-        return
-    breaks = np.nonzero(np.diff(columns) != 1)[0] + 1
-    if len(breaks) > len(columns) // 8:  # short runs: the gather is as fast
-        np.take(src if rows is None else np.take(src, rows, axis=0), columns, axis=1, out=out)
-        return
-    for a, b in zip(np.concatenate([[0], breaks]), np.concatenate([breaks, [len(columns)]])):
-        block = slice(columns[a], columns[a] + (b - a))
-        out[:, a:b] = src[:, block] if rows is None else src[rows, block]
+    """out[i] = src[rows[i], columns] (`rows`: all of them where None), a row at a time: a gather within one
+    contiguous row into another makes no temporary (mode "clip": the indices are valid, and the default mode
+    buffers `out`). Copying each run of consecutive columns for all rows at once made a temporary per run, and numpy
+    asks the kernel for huge pages for those over 4 MiB: their page faults cost the Cornell box's update 0.1–0.2 s,
+    three to seven times the copy itself; a column-at-a-time gather over the whole matrix was slower still."""
+    for i, r in enumerate(range(len(out)) if rows is None else rows):
+        np.take(src[r], columns, out=out[i], mode="clip")
 
 
 def box_pairs(ctx, programs, gv, clusters: Clusters, boxes: np.ndarray) -> np.ndarray:
@@ -119,7 +114,10 @@ def box_pairs(ctx, programs, gv, clusters: Clusters, boxes: np.ndarray) -> np.nd
     prog = programs.compute("lpv/box_pairs.glsl")
     sources = ctx.buffer(clusters.records.tobytes())
     sources.bind_to_storage_buffer(6)
+    spans = ctx.buffer(word_spans(gv.positions, words).tobytes())
+    spans.bind_to_storage_buffer(7)
     gv.receivers.bind_to_storage_buffer(10)
+    set_uniform(prog, "u_margin", 1e-4 * float(np.abs(boxes).max()) + 1e-6)
     set_uniform(prog, "u_surface_count", r)
     set_uniform(prog, "u_words", words)
     boxes = np.concatenate([[[boxes[:, 0].min(axis=0), boxes[:, 1].max(axis=0)]], boxes])  # the box around them first
@@ -133,6 +131,19 @@ def box_pairs(ctx, programs, gv, clusters: Clusters, boxes: np.ndarray) -> np.nd
         bits = np.frombuffer(data, np.uint32).reshape(count, words)
         out[first:first + count] = np.unpackbits(bits.view(np.uint8), axis=1, bitorder="little")[:, :r]
     sources.release()
+    spans.release()
+    return out
+
+
+def word_spans(positions: np.ndarray, words: int) -> np.ndarray:
+    """(words, 2, 4) float32: the box (lo, hi) around each run of 32 receivers' centroids (`positions`, (R, 3), as
+    the receivers' buffer holds them): lpv/box_pairs.glsl skips a source's 32 tests where the box around the source
+    and those centroids meets no changed box. Receivers come in voxel order, so a run is a short strip of a
+    surface, and a small edit's boxes miss most of them."""
+    p = np.asarray(positions, np.float32).reshape(-1, 3)
+    p = np.concatenate([p, np.repeat(p[-1:], words * 32 - len(p), axis=0)]).reshape(words, 32, 3)
+    out = np.zeros((words, 2, 4), np.float32)
+    out[:, 0, :3], out[:, 1, :3] = p.min(axis=1), p.max(axis=1)
     return out
 
 

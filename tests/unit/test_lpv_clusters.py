@@ -195,9 +195,9 @@ def test_the_radius_test_decides_as_the_eigenvalues_do():
 
 @pytest.mark.parametrize("runs", [True, False])
 def test_take_columns_is_a_column_gather(runs):
-    """transfer_update.take_columns copies runs of consecutive columns as slices (or gathers, where runs are short):
-    the same as np.take either way, and with rows (the kept clusters' old rows, one repeated for a fresh cluster) the
-    same as taking the rows first."""
+    """transfer_update.take_columns (a gather a row at a time): the same as np.take for runs of consecutive columns
+    (an update's kept receivers) and for scattered ones, and with rows (the kept clusters' old rows, one repeated
+    for a fresh cluster) the same as taking the rows first."""
     from bounce_gi.gpu_kernels.lpv.transfer_update import take_columns
     rng = np.random.default_rng(3)
     src = rng.random((7, 500)).astype(np.float32)
