@@ -79,6 +79,7 @@ class ShadowView:
     emit_share: float = 0.0
     pcf_radius: int | None = None  # this view's PCF radius, where not ShadowSettings.pcf_radius (the sky's: 0)
     own_extent: float = 0.0  # tan(half angle) a cube face covers alone (1; lpv/inject.glsl cube_share), else 0
+    unlit: bool = False  # sees only directions its light does not emit into: drawn into no atlas (cube_views)
 
 
 @dataclass
@@ -157,24 +158,22 @@ def _scene_radius(scene: Scene) -> tuple[np.ndarray, float]:
     return centre, max(float(np.linalg.norm(hi - lo)) / 2, floor)
 
 
-def cube_views(origin, resolution: int, near: float, far: float, emit_normal=None, emit_share: float = 0.0
-               ) -> list[ShadowView]:
+def cube_views(origin, resolution: int, near: float, far: float, emit_normal=None, emit_share: float = 0.0,
+               one_sided: bool = False) -> list[ShadowView]:
     """Six perspective views around `origin`, each a little wider than 90° so PCF never reads past a face edge.
-    A polygon light's sample point passes the normal it emits along and the share of the light it stands for."""
+    A polygon light's sample point passes the normal it emits along and the share of the light it stands for; a
+    `one_sided` one (an area light) marks unlit the faces whose every direction lies behind it (d · normal ≤ 0):
+    a point such a face would shadow gets none of the light, so the face is neither drawn nor read."""
     margin = 1.0 + 4.0 * 2 / resolution  # two texels of margin on each side
-    fov = 2 * math.atan(margin)
-    proj = cam.perspective(fov, 1.0, near, far)
+    proj = cam.perspective(2 * math.atan(margin), 1.0, near, far)
     views = []
     for fwd, up in CUBE_DIRECTIONS:
         view = cam.look_at(origin, np.asarray(origin) + fwd, up)
+        n = view[:3, :3] @ np.asarray(emit_normal, np.float64) if one_sided else None  # (right, up, back) · normal
         views.append(ShadowView(proj @ view, np.asarray(origin, np.float64), False, 2 * margin / resolution,
-                                resolution, far, view, margin, emit_normal, emit_share, own_extent=1.0))
+                                resolution, far, view, margin, emit_normal, emit_share, own_extent=1.0,
+                                unlit=one_sided and -n[2] + margin * (abs(n[0]) + abs(n[1])) <= 0.0))
     return views
-
-
-def sun_view(scene: Scene, light: Light, resolution: int) -> ShadowView:
-    """Orthographic view along the sun direction, fitted to the scene's bounding sphere."""
-    return ortho_view(scene, light.direction, resolution)
 
 
 def ortho_view(scene: Scene, d, resolution: int) -> ShadowView:
@@ -215,8 +214,7 @@ class _Records:
     """The light records, shadow views and polygon vertices being packed, in the order the shaders read them."""
 
     def __init__(self):
-        self.records, self.views, self.polys, self.warnings, self.view_lights = [], [], [], [], []
-        self.skipped = []
+        self.records, self.views, self.polys, self.warnings, self.view_lights, self.skipped = [], [], [], [], [], []
 
     def add(self, type_, color, position=(0, 0, 0), radius=0.0, direction=(0, 0, -1), cos_half=0.0, smooth=0.0,
             light_views=(), samples=0, per=0, poly=None, two_sided=False):
@@ -325,7 +323,7 @@ def _add_lamp(out: _Records, scene: Scene, light: Light, s: ShadowSettings) -> N
     perspective map, area: a cube per shadow sample point)."""
     color = _color(light)
     if light.type == "SUN":
-        v = [sun_view(scene, light, s.sun_resolution)] if light.cast_shadow else []
+        v = [ortho_view(scene, light.direction, s.sun_resolution)] if light.cast_shadow else []
         out.add(LIGHT_SUN, color * light.power, direction=light.direction, light_views=v, samples=len(v), per=1)
     elif light.type in ("POINT", "SPOT"):
         intensity = color * light.power / (4 * math.pi)
@@ -350,7 +348,7 @@ def _add_lamp(out: _Records, scene: Scene, light: Light, s: ShadowSettings) -> N
         pts = area_sample_points(light, s.area_samples) if light.cast_shadow else []
         for point in pts:
             v.extend(cube_views(point, s.area_cube_resolution, *_near_far(scene, point),
-                                np.asarray(light.direction, np.float64), area / len(pts)))
+                                np.asarray(light.direction, np.float64), area / len(pts), one_sided=True))
         out.add(LIGHT_POLYGON, radiance, poly.mean(axis=0), 0.0, light.direction, light_views=v,
                 samples=len(pts), per=6, poly=poly)
     else:

@@ -291,6 +291,8 @@ def render_depth(ctx, programs, geometry: GeometryBuffers, views: list, tiles: l
             view, tile = views[i], tiles[i]
             if plan is not None:
                 fbo.clear(depth=1.0, viewport=rect or tile)
+            if view.unlit:  # behind its light (lights.cube_views): cleared, never read
+                continue
             fbo.viewport = tile
             ctx.scissor = rect  # None: the whole tile
             write_uniform(prog, "u_view_projection", view.view_projection.T)

@@ -128,6 +128,8 @@ def render_rsm(ctx, programs, scene: Scene, geometry, textures, shadows, resolut
             continue
         if plan is not None:
             out.fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0, viewport=draws[i] or (x, y, w, h))
+        if view.unlit:  # behind its light (lights.cube_views): left empty, so it makes no records
+            continue
         out.fbo.viewport = (x, y, w, h)
         ctx.scissor = draws[i]  # None: the whole tile
         write_uniform(prog, "u_view_projection", view.view_projection.T)
