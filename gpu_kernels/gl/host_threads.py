@@ -7,19 +7,34 @@ helper spinning after the LPV's bounce solve (a product with its transfer) took 
 area light's RSM records in the Cornell box took 27–31 ms instead of 16 (benchmarks/results/llvmpipe/incremental.md,
 stop 48). So where the renderer is software the engine runs BLAS on one thread (`limit_blas_threads`). It is
 process-wide: numpy offers no per-call setting. Found as threadpoolctl finds it, without the dependency: the
-OpenBLAS library numpy loaded, by the names its builds give its thread-count functions."""
+OpenBLAS library numpy loaded, by the names its builds give its thread-count functions.
+
+With BLAS on one thread, two independent products can still use two cores: `beside` runs one on a second host
+thread (numpy releases the GIL in a product) while the caller computes the other."""
 from __future__ import annotations
 
 import ctypes
 import glob
 import os
 import sys
+from concurrent.futures import Future, ThreadPoolExecutor
 
 SOFTWARE_RENDERERS = ("llvmpipe", "softpipe", "swiftshader", "lavapipe")
 # (set, get) per OpenBLAS build: numpy ≥ 2's scipy-openblas, numpy 1.x's 64-bit-integer build, a plain one.
 _FUNCTIONS = (("scipy_openblas_set_num_threads64_", "scipy_openblas_get_num_threads64_"),
               ("openblas_set_num_threads64_", "openblas_get_num_threads64_"),
               ("openblas_set_num_threads", "openblas_get_num_threads"))
+
+
+_BESIDE: list = []  # the one worker thread `beside` runs on, made at its first use
+
+
+def beside(fn, *args) -> Future:
+    """fn(*args) run on a second host thread while the caller goes on; its Future (.result() waits for it and
+    raises what it raised)."""
+    if not _BESIDE:
+        _BESIDE.append(ThreadPoolExecutor(1, thread_name_prefix="bounce-gi-beside"))
+    return _BESIDE[0].submit(fn, *args)
 
 
 def is_software(ctx) -> bool:

@@ -32,6 +32,7 @@ import numpy as np
 
 from ..common.grid import Grid
 from ..gl.bind import bind_grid, dispatch, set_uniform
+from ..gl.host_threads import beside
 from .clusters import Clusters
 from .crossings import bind_visibility
 from .gather import vpls_per_dispatch
@@ -278,6 +279,10 @@ def solve(t: Transfer, m_rho: np.ndarray, first: np.ndarray, bounces: int, epsil
         following = _reflect(m_rho, phi)
     sums = (total if gain is None else total * gain[:, None]).T.astype(np.float32)  # (3, C)
     out = np.empty((2, t.matrix.shape[2], 3), np.float32)
-    for side in range(2):
+
+    def side_product(side):  # reading T is most of a light edit's solve: one side on each of two cores
         out[side, t.order[side]] = (sums @ t.matrix[side]).T
+    back = beside(side_product, 1)
+    side_product(0)
+    back.result()
     return out, passes

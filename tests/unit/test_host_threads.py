@@ -33,3 +33,18 @@ def test_software_renderers_are_told_from_hardware_ones():
     assert not host_threads.is_software(ctx("NVIDIA H100 80GB HBM3/PCIe/SSE2"))
     assert not host_threads.is_software(ctx("AMD Radeon RX 7900 XTX (radeonsi, navi31, LLVM 17.0.6, DRM 3.54)"))
     assert not host_threads.is_software(SimpleNamespace(info={}))
+
+
+def test_beside_runs_on_another_thread_and_hands_back_its_result_or_error():
+    import threading
+
+    import pytest
+
+    from bounce_gi.gpu_kernels.gl.host_threads import beside
+    assert beside(lambda a, b: (a + b, threading.get_ident()), 2, 3).result()[0] == 5
+    assert beside(threading.get_ident).result() != threading.get_ident()
+
+    def fails():
+        raise ValueError("from the other thread")
+    with pytest.raises(ValueError, match="other thread"):
+        beside(fails).result()
