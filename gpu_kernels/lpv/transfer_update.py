@@ -28,6 +28,11 @@ PAIRS_PER_DISPATCH = 1 << 20  # pairs evaluated per dispatch and listed at a tim
 # 1024 sources against eight boxes listed half the pairs that cross them).
 MASK_INVOCATIONS = 65535 * 64
 MAX_BOXES = 8  # boxes around the changed cells (changed_boxes); lpv/box_pairs.glsl holds one more
+# The share of pairs to evaluate from which T is built anew instead. A pair costs the update about what it costs a
+# build (measured on llvmpipe: 0.20–0.25 µs evaluated one per invocation, 0.27–0.29 µs in a build), and the update
+# adds listing the pairs and copying the kept ones (a tenth of a build or less): at half of T it was still two
+# thirds of a build (the courtyard's floor lifted 5 cm, 52–58% of its pairs: 1.45–1.50 s against 2.1–2.3 s).
+REBUILD_SHARE = 0.9
 # What an edit leaves the same, to float rounding: a receiver's or cluster's row is kept where no entry moved by more
 # than these (normals: unit; areas: × the fine voxel's face; positions: × its edge). Moving an object re-derives its
 # triangles in world space, and the float32 arithmetic of its voxels' areas, normals and centroids changes in the
@@ -39,10 +44,10 @@ NORMAL_TOLERANCE = 1e-5
 EXTENT_TOLERANCE = 1e-4
 
 
-def update_transfer(ctx, programs, gv, grid: Grid, occlusion: bool, prior, limit: float = 0.5, spare=None):
+def update_transfer(ctx, programs, gv, grid: Grid, occlusion: bool, prior, limit: float | None = None, spare=None):
     """The Transfer after a geometry edit, from `prior` (the one before it), its T written into `spare`'s memory
-    where it fits (transfer.empty_matrix); None where the share of pairs to evaluate would reach `limit` (build T
-    anew instead)."""
+    where it fits (transfer.empty_matrix); None where the share of pairs to evaluate would reach `limit` (default
+    REBUILD_SHARE: build T anew instead)."""
     new = make_clusters(gv.cells, gv.surface_normal, gv.surface_area, gv.fine, 0, block=prior.clusters.block,
                         positions=gv.positions, bounds=gv.bounds, detached=prior.clusters.detached)
     before, after = prior.rows, receiver_rows(gv)
@@ -57,7 +62,7 @@ def update_transfer(ctx, programs, gv, grid: Grid, occlusion: bool, prior, limit
         fresh |= box_pairs(ctx, programs, gv, new, boxes)
     per_source = np.count_nonzero(fresh, axis=1)
     share = int(per_source.sum()) / max(fresh.size, 1)
-    if share >= limit:
+    if share >= (REBUILD_SHARE if limit is None else limit):
         return None
     order, starts = cluster_order(new)
     columns = []

@@ -124,9 +124,11 @@ def test_lifting_a_turned_post_lists_the_pairs_near_its_ends_only(monkeypatch):
 
 
 def test_an_edit_that_changes_most_of_the_transfer_builds_it_anew_without_updating(monkeypatch):
-    """A 1.2 m box lifted 30 cm changes more than half of T's pairs: T is made anew (the share reads 1), and no
-    pair is evaluated for an update first (the courtyard's object move paid for both)."""
+    """A 1.2 m box lifted 30 cm changes more than half of T's pairs: with the rebuild share at a half, T is made
+    anew (the share reads 1), and no pair is evaluated for an update first (the courtyard's object move paid for
+    both)."""
     evaluated, updates, update = [], [], transfer_update.update_transfer
+    monkeypatch.setattr(transfer_update, "REBUILD_SHARE", 0.5)
     monkeypatch.setattr(transfer_update, "evaluate_pairs", lambda *a: evaluated.append(len(a[-1])))
     monkeypatch.setattr(transfer_update, "update_transfer", lambda *a, **k: updates.append(update(*a, **k)))
     engine = Engine()
@@ -134,6 +136,18 @@ def test_an_edit_that_changes_most_of_the_transfer_builds_it_anew_without_updati
     moved = engine.render(room_with_box(0.3, size=1.2), SETTINGS)
     assert "lpv_transfer" in rerun(moved) and moved.info["cascades"][0]["transfer_updated"] == 1.0
     assert updates == [None] and evaluated == []  # an update was tried, and gave up before evaluating a pair
+    assert_same(indirect(moved), indirect(Engine().render(room_with_box(0.3, size=1.2), SETTINGS)))
+
+
+def test_an_edit_that_changes_over_half_of_the_transfer_still_updates_it():
+    """The same edit with the default rebuild share (transfer_update.REBUILD_SHARE: a pair costs an update what it
+    costs a build): T is updated, over half of it evaluated again, and gives a cold render's result."""
+    engine = Engine()
+    engine.render(room_with_box(0.0, size=1.2), SETTINGS)
+    moved = engine.render(room_with_box(0.3, size=1.2), SETTINGS)
+    share = moved.info["cascades"][0]["transfer_updated"]
+    print("share of T re-evaluated:", share)
+    assert "lpv_transfer" in rerun(moved) and 0.5 < share < transfer_update.REBUILD_SHARE
     assert_same(indirect(moved), indirect(Engine().render(room_with_box(0.3, size=1.2), SETTINGS)))
 
 
