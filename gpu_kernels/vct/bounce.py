@@ -8,7 +8,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..common.bounce_tail import tail_ratio, tail_sum
-from ..gl.bind import bind_samplers, dispatch, set_uniform, texture3d
+from ..gl.bind import VOLUME_GROUP, bind_samplers, dispatch, dispatch_counted, set_uniform, texture3d
 from .inject import face_flux
 from .mipmap import build_volumes
 from .settings import VctSettings
@@ -27,6 +27,7 @@ def bounce(ctx, programs, vox, direct_faces: Faces, volumes: ConeVolumes, s: Vct
                            bounce_stats=stats, layers=volumes.layers, layers_owned=False)
     grid = direct_faces.grid
     faces = Faces([texture3d(ctx, grid.size, zero=True) for _ in range(6)], grid, direct_faces.levels)
+    listed, count = face_list(ctx, programs, direct_faces)
     prog = programs.compute("vct/bounce.glsl", {"MODE_ANISO": None} if volumes.anisotropic else None)
     own, source, previous = None, volumes, None
     for b in range(2, gathered + 1):
@@ -42,13 +43,14 @@ def bounce(ctx, programs, vox, direct_faces: Faces, volumes: ConeVolumes, s: Vct
                    replace(s, diffuse_cones=s.bounce_cones or s.diffuse_cones))
         for i, t in enumerate(faces.textures):
             t.bind_to_image(i, read=False, write=True)
-        dispatch(prog, grid.size)
+        gather_listed(prog, listed, count)
         ctx.memory_barrier()
         own = source = build_volumes(ctx, programs, faces, volumes.anisotropic, into=own, layers=volumes.layers)
         stats.append({"bounce": b, "flux": face_flux(ctx, programs, faces)[0]})
         if _total(stats[-1]) - _total(stats[-2]) < s.epsilon * _total(stats[0]):
             stats[-1]["stopped"] = True  # the series ends here: no further gather, no tail
             break
+    listed.release()
     if previous is not None and stats[-1].get("stopped"):
         if previous is not direct_faces:
             previous.release()
@@ -59,6 +61,29 @@ def bounce(ctx, programs, vox, direct_faces: Faces, volumes: ConeVolumes, s: Vct
         own = build_volumes(ctx, programs, faces, volumes.anisotropic, into=own, layers=volumes.layers)
     own.faces, own.bounce_stats = faces, stats
     return own
+
+
+FACES_PER_DISPATCH = 65535 * 64  # work groups of 64 (vct/bounce.glsl), at most 65535 a dispatch
+
+
+def face_list(ctx, programs, faces: Faces) -> tuple:
+    """The faces of `faces` with coverage, (voxel, face) as ivec4 in a storage buffer (vct/bounce.glsl MODE_LIST:
+    at most six per occupied voxel), and how many."""
+    listed = ctx.buffer(reserve=16 * max(6 * int(faces.occupied), 1))
+    prog = programs.compute("vct/bounce.glsl", {"MODE_LIST": None})
+    bind_samplers(prog, "u_direct", faces.textures, 0)
+    set_uniform(prog, "u_grid_size", tuple(int(n) for n in faces.grid.size))
+    listed.bind_to_storage_buffer(5)
+    return listed, dispatch_counted(ctx, prog, faces.grid.size, VOLUME_GROUP)
+
+
+def gather_listed(prog, listed, count: int) -> None:
+    """vct/bounce.glsl over the `count` faces of `listed` (face_list), one per invocation."""
+    listed.bind_to_storage_buffer(5)
+    set_uniform(prog, "u_face_count", count)
+    for first in range(0, count, FACES_PER_DISPATCH):
+        set_uniform(prog, "u_face_first", first)
+        dispatch(prog, (min(FACES_PER_DISPATCH, count - first),), 64)
 
 
 def _total(stat: dict) -> float:

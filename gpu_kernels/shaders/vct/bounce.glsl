@@ -8,36 +8,49 @@
 // so an edge voxel's wall face gathers from the wall inside the room, not from under the floor crossing its
 // centre; the tangent plane is the face's (axis) normal through that point. A face without raster samples uses
 // its face centre.
+// The faces are gathered from a list of those with coverage (MODE_LIST makes it once per injection), one face per
+// invocation: over the grid, a SIMD group of voxels along a wall's normal had one lane with a face and seven idle
+// for all its cones, and a floor voxel beside a wall voxel ran both faces' cones in every lane.
 #include "vct/common.glsl"
 #include "vct/arrays.glsl"
 
-layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;  // gl/bind.VOLUME_GROUP
 uniform sampler3D u_direct[6];   // vct_inject faces: rgb = L_direct, a = α_g
-uniform sampler3D u_albedo;
-layout(rgba32f, binding = 0) uniform writeonly image3D u_face[6];
 VCT_FETCH6(direct_face, u_direct)
-VCT_STORE6(store_face, u_face)
+
+#if defined(MODE_LIST)
+layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;  // gl/bind.VOLUME_GROUP
+layout(std430, binding = 3) buffer Count { uint face_count; };    // gl/bind.dispatch_counted
+layout(std430, binding = 5) writeonly buffer FaceList { ivec4 faces[]; };   // voxel, face g
 
 void main() {
     ivec3 v = ivec3(gl_GlobalInvocationID);
     if (any(greaterThanEqual(v, u_grid_size))) return;
-    vec4 direct[6];
-    float coverage = 0.0;
-    for (int g = 0; g < 6; ++g) {
-        direct[g] = direct_face(g, v, 0);
-        coverage = max(coverage, direct[g].a);
-    }
-    if (coverage <= 0.0) return;   // an empty voxel (the face images start zeroed, vct._texture3d)
-    vec3 albedo = texelFetch(u_albedo, v, 0).rgb;
-    bool reflects = max(albedo.r, max(albedo.g, albedo.b)) > 0.0;
-    for (int g = 0; g < 6; ++g) {
-        vec3 radiance = direct[g].rgb;
-        if (direct[g].a > 0.0 && reflects) {
-            vec3 n = vec3(0.0);
-            n[g >> 1] = (g & 1) == 0 ? 1.0 : -1.0;
-            vec4 e = gather_irradiance(centroid_face(g, v, 0).xyz, n, n, vec2(1.0, 0.0));
-            radiance += albedo * e.rgb / VCT_PI;
-        }
-        store_face(g, v, vec4(radiance, direct[g].a));
-    }
+    for (int g = 0; g < 6; ++g)
+        if (direct_face(g, v, 0).a > 0.0) faces[atomicAdd(face_count, 1u)] = ivec4(v, g);
 }
+#else
+layout(local_size_x = 64) in;
+layout(std430, binding = 5) readonly buffer FaceList { ivec4 faces[]; };
+uniform int u_face_first;   // this dispatch's first face (at most 65535 groups a dispatch)
+uniform int u_face_count;   // faces in the list
+uniform sampler3D u_albedo;
+layout(rgba32f, binding = 0) uniform writeonly image3D u_face[6];
+VCT_STORE6(store_face, u_face)
+
+void main() {   // the faces without coverage keep the zeros their images start with (vct._texture3d)
+    int i = u_face_first + int(gl_GlobalInvocationID.x);
+    if (i >= u_face_count) return;
+    ivec3 v = faces[i].xyz;
+    int g = faces[i].w;
+    vec4 direct = direct_face(g, v, 0);
+    vec3 albedo = texelFetch(u_albedo, v, 0).rgb;
+    vec3 radiance = direct.rgb;
+    if (max(albedo.r, max(albedo.g, albedo.b)) > 0.0) {
+        vec3 n = vec3(0.0);
+        n[g >> 1] = (g & 1) == 0 ? 1.0 : -1.0;
+        vec4 e = gather_irradiance(centroid_face(g, v, 0).xyz, n, n, vec2(1.0, 0.0));
+        radiance += albedo * e.rgb / VCT_PI;
+    }
+    store_face(g, v, vec4(radiance, direct.a));
+}
+#endif
