@@ -294,6 +294,7 @@ def _transfer_geometry(frame, grids, k_grids, budget) -> tuple:
     k_tr = (k_gv, budget, s.occlusion)
     # A kept T of the same grids (k_gv's grid keys), budget and occlusion, made before a geometry edit.
     priors = cache.prior("lpv_transfer", lambda key: key[1:] == k_tr[1:] and key[0][1] == k_gv[1]) or [None] * len(gvs)
+
     def build():  # written into the memory of the T this one evicts, where it fits (PassCache.spare)
         spares = list(cache.spare("lpv_transfer", besides=priors) or [])
         spares += [None] * (len(gvs) - len(spares))
@@ -324,7 +325,7 @@ def skipped_work(stats: list, s) -> list:
 
 def _build(ctx, programs, gv, grid, budget, s, prior=None, spare=None) -> transfer.Transfer:
     """Clusters and T of one cascade: updated from `prior` (the same grid before a geometry edit) where that
-    re-evaluates under half of T (lpv/transfer_update.py), else made anew with the budget re-checked against the
+    re-evaluates less than transfer_update.REBUILD_SHARE of T, else made anew with the budget re-checked against the
     real surface-voxel count; T in `spare`'s memory where it fits (transfer.empty_matrix)."""
     updated = transfer_update.update_transfer(ctx, programs, gv, grid, s.occlusion, prior, spare=spare) \
         if prior is not None and prior.grid == grid else None
