@@ -149,7 +149,8 @@ def _buffer(a: np.ndarray | None) -> np.ndarray | None:
     """The whole float32 buffer `a` is a view of (empty_matrix's, with its spare room), flat; None if there is none."""
     while a is not None and isinstance(a.base, np.ndarray):
         a = a.base
-    return a.reshape(-1) if a is not None and a.dtype == np.float32 and a.flags.c_contiguous else None
+    usable = a is not None and a.dtype == np.float32 and a.flags.c_contiguous and a.flags.writeable
+    return a.reshape(-1) if usable else None
 
 
 def sort_by_cluster(clusters: Clusters, matrix: np.ndarray, gv=None, grid: Grid | None = None,

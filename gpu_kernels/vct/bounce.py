@@ -66,15 +66,22 @@ def bounce(ctx, programs, vox, direct_faces: Faces, volumes: ConeVolumes, s: Vct
 FACES_PER_DISPATCH = 65535 * 64  # work groups of 64 (vct/bounce.glsl), at most 65535 a dispatch
 
 
-def face_list(ctx, programs, faces: Faces) -> tuple:
-    """The faces of `faces` with coverage, (voxel, face) as ivec4 in a storage buffer (vct/bounce.glsl MODE_LIST:
-    at most six per occupied voxel), and how many."""
-    listed = ctx.buffer(reserve=16 * max(6 * int(faces.occupied), 1))
+def face_list(ctx, programs, faces: Faces, capacity: int | None = None) -> tuple:
+    """The faces of `faces` with coverage, (voxel, face) as ivec4 in a storage buffer (vct/bounce.glsl MODE_LIST),
+    and how many; room for `capacity` (default six per occupied voxel, Faces.occupied), made again larger where
+    more were counted."""
+    capacity = max(6 * int(faces.occupied) if capacity is None else capacity, 1)
+    listed = ctx.buffer(reserve=16 * capacity)
     prog = programs.compute("vct/bounce.glsl", {"MODE_LIST": None})
     bind_samplers(prog, "u_direct", faces.textures, 0)
     set_uniform(prog, "u_grid_size", tuple(int(n) for n in faces.grid.size))
+    set_uniform(prog, "u_capacity", capacity)
     listed.bind_to_storage_buffer(5)
-    return listed, dispatch_counted(ctx, prog, faces.grid.size, VOLUME_GROUP)
+    count = dispatch_counted(ctx, prog, faces.grid.size, VOLUME_GROUP)
+    if count > capacity:
+        listed.release()
+        return face_list(ctx, programs, faces, count)
+    return listed, count
 
 
 def gather_listed(prog, listed, count: int) -> None:

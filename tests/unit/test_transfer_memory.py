@@ -21,6 +21,8 @@ def test_a_spare_is_reused_only_where_it_fits_and_is_not_much_larger():
     assert not np.shares_memory(empty_matrix((2, 50, 80), spare=spare), spare)  # 8000: would keep 2.25× its size
     assert np.shares_memory(empty_matrix((2, 90, 80), spare=spare), spare)  # 14400 ≤ 18000 ≤ 1.25 × 14400
     assert not np.shares_memory(empty_matrix((2, 90, 80), spare=np.zeros(18000, np.float64)), spare)
+    read_only = np.frombuffer(np.zeros(18000, np.float32).tobytes(), np.float32)  # as a read-back gives it
+    assert not np.shares_memory(empty_matrix((2, 90, 80), spare=read_only), read_only)
     assert empty_matrix((0, 5, 5), spare=None).shape == (0, 5, 5)
 
 

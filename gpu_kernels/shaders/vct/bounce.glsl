@@ -21,12 +21,16 @@ VCT_FETCH6(direct_face, u_direct)
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;  // gl/bind.VOLUME_GROUP
 layout(std430, binding = 3) buffer Count { uint face_count; };    // gl/bind.dispatch_counted
 layout(std430, binding = 5) writeonly buffer FaceList { ivec4 faces[]; };   // voxel, face g
+uniform uint u_capacity;   // faces the list holds: the count goes on past it (vct/bounce.face_list makes it larger)
 
 void main() {
     ivec3 v = ivec3(gl_GlobalInvocationID);
     if (any(greaterThanEqual(v, u_grid_size))) return;
-    for (int g = 0; g < 6; ++g)
-        if (direct_face(g, v, 0).a > 0.0) faces[atomicAdd(face_count, 1u)] = ivec4(v, g);
+    for (int g = 0; g < 6; ++g) {
+        if (direct_face(g, v, 0).a <= 0.0) continue;
+        uint i = atomicAdd(face_count, 1u);
+        if (i < u_capacity) faces[i] = ivec4(v, g);
+    }
 }
 #else
 layout(local_size_x = 64) in;
