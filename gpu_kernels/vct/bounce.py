@@ -81,6 +81,11 @@ def face_list(ctx, programs, faces: Faces, capacity: int | None = None) -> tuple
     if count > capacity:
         listed.release()
         return face_list(ctx, programs, faces, count)
+    # The atomic counter lists the faces in an order that changes from run to run: sorted (by face direction, then
+    # voxel), every run groups the same faces into SIMD groups, whose cones then point alike (measured: as fast).
+    entries = np.frombuffer(listed.read(size=16 * count), np.int32).reshape(count, 4)
+    entries = entries[np.lexsort((entries[:, 0], entries[:, 1], entries[:, 2], entries[:, 3]))]
+    listed.write(np.ascontiguousarray(entries).tobytes())
     return listed, count
 
 
