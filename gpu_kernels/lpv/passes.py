@@ -326,12 +326,13 @@ def skipped_work(stats: list, s) -> list:
 def _build(ctx, programs, gv, grid, budget, s, prior=None, spare=None) -> transfer.Transfer:
     """Clusters and T of one cascade: updated from `prior` (the same grid before a geometry edit) where that
     re-evaluates less than transfer_update.REBUILD_SHARE of T, else made anew with the budget re-checked against the
-    real surface-voxel count; T in `spare`'s memory where it fits (transfer.empty_matrix)."""
-    updated = transfer_update.update_transfer(ctx, programs, gv, grid, s.occlusion, prior, spare=spare) \
-        if prior is not None and prior.grid == grid else None
+    real surface-voxel count (an update past it builds anew too); T in `spare`'s memory where it fits
+    (transfer.empty_matrix)."""
+    fits = int(s.transfer_mb * 2 ** 20 / (8 * max(gv.surface_count, 1)))  # clusters whose T fits transfer_mb
+    updated = transfer_update.update_transfer(ctx, programs, gv, grid, s.occlusion, prior, spare=spare,
+                                              most_clusters=fits) if prior is not None and prior.grid == grid else None
     if updated is not None:
         return updated
-    fits = int(s.transfer_mb * 2 ** 20 / (8 * max(gv.surface_count, 1)))
     sources = clusters.make_clusters(gv.cells, gv.surface_normal, gv.surface_area, gv.fine,
                                      max(transfer.MIN_CLUSTERS, min(budget, fits)), positions=gv.positions,
                                      bounds=gv.bounds)

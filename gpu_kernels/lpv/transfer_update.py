@@ -44,12 +44,16 @@ NORMAL_TOLERANCE = 1e-5
 EXTENT_TOLERANCE = 1e-4
 
 
-def update_transfer(ctx, programs, gv, grid: Grid, occlusion: bool, prior, limit: float | None = None, spare=None):
+def update_transfer(ctx, programs, gv, grid: Grid, occlusion: bool, prior, limit: float | None = None, spare=None,
+                    most_clusters: int | None = None):
     """The Transfer after a geometry edit, from `prior` (the one before it), its T written into `spare`'s memory
     where it fits (transfer.empty_matrix); None where the share of pairs to evaluate would reach `limit` (default
-    REBUILD_SHARE: build T anew instead)."""
+    REBUILD_SHARE), or the clusters re-made with the prior's blocks would outnumber `most_clusters` (the memory
+    budget: a build picks larger blocks): build T anew instead."""
     new = make_clusters(gv.cells, gv.surface_normal, gv.surface_area, gv.fine, 0, block=prior.clusters.block,
                         positions=gv.positions, bounds=gv.bounds, detached=prior.clusters.detached)
+    if most_clusters is not None and new.count > most_clusters:
+        return None
     before, after = prior.rows, receiver_rows(gv)
     cell = float(gv.fine.cell)
     old_r = _match_receivers(before, after, cell)

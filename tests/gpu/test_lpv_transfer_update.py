@@ -189,3 +189,20 @@ def test_the_second_update_writes_into_the_memory_of_the_transfer_it_evicts():
         assert_same(indirect(second), indirect(Engine().render(room_with_box(0.10), SETTINGS)))
     finally:
         engine.shutdown()
+
+
+def test_an_update_that_would_outgrow_the_memory_budget_builds_anew(monkeypatch):
+    """Re-made with the prior's blocks, the clusters may outnumber what transfer_mb allows for the new receivers
+    (a build picks larger blocks): the update gives up before evaluating a pair, and T is built anew. Here the
+    budget the update is given is one cluster."""
+    results, update = [], transfer_update.update_transfer
+
+    def tight(*a, **k):
+        results.append(update(*a, **{**k, "most_clusters": 1}))
+        return results[-1]
+    monkeypatch.setattr(transfer_update, "update_transfer", tight)
+    monkeypatch.setattr(transfer_update, "evaluate_pairs", lambda *a: pytest.fail("no pair is evaluated"))
+    engine = Engine()
+    engine.render(room_with_box(0.0), SETTINGS)
+    moved = engine.render(room_with_box(0.05), SETTINGS)
+    assert results == [None] and moved.info["cascades"][0]["transfer_updated"] == 1.0
