@@ -337,7 +337,7 @@ def _build(ctx, programs, gv, grid, budget, s, prior=None, spare=None) -> transf
                                      max(transfer.MIN_CLUSTERS, min(budget, fits)), positions=gv.positions,
                                      bounds=gv.bounds)
     matrix = transfer.build_transfer(ctx, programs, gv, grid, sources, s.occlusion)
-    return transfer.sort_by_cluster(sources, matrix, gv, grid, spare)
+    return transfer.sort_by_cluster(sources, matrix, gv, grid, spare, most=2 * fits * int(gv.surface_count))
 
 
 def _solve(ctx, programs, gvs, grids, transfers, reflection, sources, s) -> dict:

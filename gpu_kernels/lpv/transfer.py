@@ -132,17 +132,19 @@ def cluster_order(clusters: Clusters) -> tuple[list, list]:
     return order, starts
 
 
-def empty_matrix(shape: tuple, spare: np.ndarray | None = None) -> np.ndarray:
+def empty_matrix(shape: tuple, spare: np.ndarray | None = None, most: int | None = None) -> np.ndarray:
     """An uninitialised float32 array of `shape`, in the memory of `spare` (a T no longer kept: PassCache.spare)
     where that holds it and is at most a quarter larger (a small T would otherwise keep a large one's memory), else
-    in new memory with an eighth to spare, so that the next edit's T, a few clusters or receivers larger, fits in
-    it. New memory costs its page faults when first written (the kernel's, zeroing and finding huge pages: up to
-    0.1 s for the Cornell box's 90 MB), memory reused does not."""
+    in new memory with up to an eighth to spare (no more than `most` elements in all: the transfer_mb budget), so
+    that the next edit's T, a few clusters or receivers larger, fits in it. New memory costs its page faults when
+    first written (the kernel's, zeroing and finding huge pages: up to 0.1 s for the Cornell box's 90 MB), memory
+    reused does not."""
     n = int(np.prod(shape))
     flat = _buffer(spare)
     if flat is not None and n <= flat.size <= n + n // 4:
         return flat[:n].reshape(shape)
-    return np.empty(n + n // 8, np.float32)[:n].reshape(shape)
+    room = n // 8 if most is None else max(0, min(n // 8, int(most) - n))
+    return np.empty(n + room, np.float32)[:n].reshape(shape)
 
 
 def _buffer(a: np.ndarray | None) -> np.ndarray | None:
@@ -154,11 +156,11 @@ def _buffer(a: np.ndarray | None) -> np.ndarray | None:
 
 
 def sort_by_cluster(clusters: Clusters, matrix: np.ndarray, gv=None, grid: Grid | None = None,
-                    spare: np.ndarray | None = None) -> Transfer:
+                    spare: np.ndarray | None = None, most: int | None = None) -> Transfer:
     """`matrix` (2, C, R) in receiver order → a Transfer with each side's columns grouped by cluster (and the
-    receivers of `gv` recorded), written into `spare`'s memory where it fits (empty_matrix)."""
+    receivers of `gv` recorded), written into `spare`'s memory where it fits (empty_matrix; `most`: its cap)."""
     order, starts = cluster_order(clusters)
-    out = empty_matrix(matrix.shape, spare)
+    out = empty_matrix(matrix.shape, spare, most)
     for side in range(2):
         np.take(matrix[side], order[side], axis=1, out=out[side])  # 5× faster than matrix[side][:, perm] here
     return sorted_transfer(clusters, out, order, starts, gv, grid)

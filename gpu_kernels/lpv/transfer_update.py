@@ -70,7 +70,8 @@ def update_transfer(ctx, programs, gv, grid: Grid, occlusion: bool, prior, limit
         return None
     order, starts = cluster_order(new)
     columns = []
-    matrix = empty_matrix((2, new.count, int(gv.surface_count)), spare)
+    r = int(gv.surface_count)  # room to grow within the budget most_clusters stands for
+    matrix = empty_matrix((2, new.count, r), spare, None if most_clusters is None else 2 * most_clusters * r)
     for side in range(2):  # columns in the new clusters' order: the kept pairs' old values, then the fresh ones
         old_column = np.empty(len(prior.order[side]), np.int64)
         old_column[prior.order[side]] = np.arange(len(old_column))

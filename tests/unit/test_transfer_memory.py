@@ -15,6 +15,14 @@ def test_new_memory_leaves_an_eighth_to_grow_into():
     assert grown.shape == (2, 104, 84) and np.shares_memory(grown, a)
 
 
+def test_the_room_to_grow_stays_within_the_budget():
+    """`most` (the transfer_mb budget, in elements) caps the buffer: the eighth is cut to what the budget leaves, and
+    none where T alone fills it."""
+    assert empty_matrix((2, 100, 80), most=16500).base.size == 16500
+    assert empty_matrix((2, 100, 80), most=16000).base.size == 16000
+    assert empty_matrix((2, 100, 80), most=10**9).base.size == 18000
+
+
 def test_a_spare_is_reused_only_where_it_fits_and_is_not_much_larger():
     spare = empty_matrix((2, 100, 80))  # 18000 floats of memory
     assert not np.shares_memory(empty_matrix((2, 120, 80), spare=spare), spare)  # 19200: too small
