@@ -14,6 +14,7 @@ thread (numpy releases the GIL in a product) while the caller computes the other
 from __future__ import annotations
 
 import ctypes
+import functools
 import glob
 import os
 import sys
@@ -26,15 +27,16 @@ _FUNCTIONS = (("scipy_openblas_set_num_threads64_", "scipy_openblas_get_num_thre
               ("openblas_set_num_threads", "openblas_get_num_threads"))
 
 
-_BESIDE: list = []  # the one worker thread `beside` runs on, made at its first use
+@functools.cache
+def _second_thread() -> ThreadPoolExecutor:
+    """The one worker thread `beside` runs on, made at its first use."""
+    return ThreadPoolExecutor(1, thread_name_prefix="bounce-gi-beside")
 
 
 def beside(fn, *args) -> Future:
     """fn(*args) run on a second host thread while the caller goes on; its Future (.result() waits for it and
     raises what it raised)."""
-    if not _BESIDE:
-        _BESIDE.append(ThreadPoolExecutor(1, thread_name_prefix="bounce-gi-beside"))
-    return _BESIDE[0].submit(fn, *args)
+    return _second_thread().submit(fn, *args)
 
 
 def is_software(ctx) -> bool:
