@@ -12,8 +12,8 @@ import numpy as np
 
 from ..common.lights import SKY_INJECTION_STRIDE
 from ..direct.geometry import POSITION_ONLY, POSITION_UV, draw_by_material
-from ..gl.bind import (bind_grid, bind_lights, bind_samplers, dispatch, set_uniform, set_uniforms, texture3d,
-                       zero_texture)
+from ..gl.bind import (VOLUME_GROUP, bind_grid, bind_lights, bind_samplers, dispatch, dispatch_counted, set_uniform,
+                       set_uniforms, texture3d, zero_texture)
 from ..scene import Scene
 from .volumes import Faces
 
@@ -60,21 +60,57 @@ def inject(ctx, programs, scene: Scene, geometry, textures: list, vox, shadows, 
                 t.release()
 
         for outputs, defines in ((faces.textures, {}), (faces.centroids, {"WRITE_CENTROIDS": None})):
-            prog = programs.compute("vct/inject.glsl", {"MODE_RESOLVE": None, **defines, **shadows.defines})
-            unit = bind_samplers(prog, "u_area", [vox.area], 0)
-            unit = bind_samplers(prog, "u_albedo", [vox.albedo], unit)
-            unit = bind_samplers(prog, "u_normal", [vox.normal], unit)
-            unit = bind_samplers(prog, "u_acc", [acc], unit)
-            bind_lights(prog, shadows, unit, sky_stride=SKY_INJECTION_STRIDE)
-            bind_grid(prog, grid, 1)
-            for i, t in enumerate(outputs):
-                t.bind_to_image(i, read=False, write=True)
-            dispatch(prog, grid.size)
-            ctx.memory_barrier()
+            prog = _resolve_program(programs, {"MODE_RESOLVE": None, **defines}, vox, acc, shadows, grid, outputs)
+            if defines:
+                dispatch(prog, grid.size)
+                ctx.memory_barrier()
+            else:
+                _light_fallback_faces(ctx, programs, prog, vox, acc, shadows, grid, outputs)
     finally:
         acc.release()
     faces.flux, faces.occupied, faces.missed = face_flux(ctx, programs, faces)
     return faces
+
+
+def _resolve_program(programs, defines: dict, vox, acc, shadows, grid, outputs):
+    """vct/inject.glsl in mode `defines`, its volumes, lights, grid and output images bound."""
+    prog = programs.compute("vct/inject.glsl", {**defines, **shadows.defines})
+    unit = bind_samplers(prog, "u_area", [vox.area], 0)
+    unit = bind_samplers(prog, "u_albedo", [vox.albedo], unit)
+    unit = bind_samplers(prog, "u_normal", [vox.normal], unit)
+    unit = bind_samplers(prog, "u_acc", [acc], unit)
+    bind_lights(prog, shadows, unit, sky_stride=SKY_INJECTION_STRIDE)
+    bind_grid(prog, grid, 1)
+    for i, t in enumerate(outputs):
+        t.bind_to_image(i, read=False, write=True)
+    return prog
+
+
+FALLBACK_ROOM = 4096  # entries of the fallback faces' first list (made again larger where more are counted)
+FALLBACK_PER_DISPATCH = 65535 * 64  # work groups of 64 (vct/inject.glsl MODE_FALLBACK), at most 65535 a dispatch
+
+
+def _light_fallback_faces(ctx, programs, resolve, vox, acc, shadows, grid, outputs, room: int | None = None):
+    """Run the faces' resolve (`resolve`, bound), which lists the faces that caught no raster sample (room for
+    `room`, default FALLBACK_ROOM), then light those one per invocation (vct/inject.glsl MODE_FALLBACK)."""
+    room = FALLBACK_ROOM if room is None else room
+    listed = ctx.buffer(reserve=16 * room)
+    try:
+        listed.bind_to_storage_buffer(5)
+        set_uniform(resolve, "u_capacity", room)
+        count = dispatch_counted(ctx, resolve, grid.size, VOLUME_GROUP)
+        if count > room:  # the resolve writes the same faces again, and lists them all
+            return _light_fallback_faces(ctx, programs, resolve, vox, acc, shadows, grid, outputs, count)
+        if count:
+            prog = _resolve_program(programs, {"MODE_FALLBACK": None}, vox, acc, shadows, grid, outputs)
+            listed.bind_to_storage_buffer(5)
+            set_uniform(prog, "u_count", count)
+            for first in range(0, count, FALLBACK_PER_DISPATCH):
+                set_uniform(prog, "u_first", first)
+                dispatch(prog, (min(FALLBACK_PER_DISPATCH, count - first),), 64)
+            ctx.memory_barrier()
+    finally:
+        listed.release()
 
 
 def front_bytes(grid) -> int:

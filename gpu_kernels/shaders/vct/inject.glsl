@@ -10,13 +10,19 @@
 //         along that axis; the same for both faces of an axis), a tilted plane's column summed (column_area),
 //   c_g = Σ w·p / Σ w, where those surface points lie (the bounce pass gathers from there).
 // A face that has coverage but caught no fragment (a sliver thinner than the raster's pixels) falls back to one
-// evaluation at the face centre with the face normal: L_g = albedo·E(centre + n_g·cell/2, n_g)/π.
+// evaluation at the face centre with the face normal: L_g = albedo·E(centre + n_g·cell/2, n_g)/π. The resolve lists
+// those faces and MODE_FALLBACK lights them, one per invocation: lit in the resolve, every voxel of a SIMD group paid
+// for the group's few fallback faces, up to six times over (measured, the Cornell box's 3244 of them: 190 ms of
+// resolve, 35 without the lighting).
 // Emission is not injected: emissive triangles are lights (common/lights.py), so E already carries their light,
 // and adding it again would count it twice (Cycles' Diffuse Indirect never holds emission). A closed emitter emits
 // outwards only (common/emitters.py): its inner light would leak out of the voxels.
 // MODE_CLEAR zeroes the accumulator; MODE_RESOLVE writes the faces: rgb = L_g, a = α_g, and centroids: xyz = c_g,
-// w = α_g (or the face centre and w = −α_g for a fallback face; w = 0 where the voxel has no surface).
+// w = α_g (or the face centre and w = −α_g for a fallback face; w = 0 where the voxel has no surface);
+// MODE_FALLBACK lights the fallback faces the resolve listed.
+#if !defined(MODE_FALLBACK)
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;  // gl/bind.VOLUME_GROUP
+#endif
 uniform ivec3 u_grid_size;
 
 #if defined(MODE_CLEAR)
@@ -29,7 +35,7 @@ void main() {
 }
 #endif
 
-#if defined(MODE_RESOLVE)
+#if defined(MODE_RESOLVE) || defined(MODE_FALLBACK)
 #include "common/lights.glsl"
 #include "common/light_eval.glsl"
 #include "direct/eval.glsl"
@@ -45,6 +51,41 @@ uniform usampler3D u_acc;        // vct/inject_raster.glsl's sums (float bits)
 layout(rgba32f, binding = 0) uniform writeonly image3D u_out[6];       // +x, −x, +y, −y, +z, −z
 #include "vct/arrays.glsl"
 VCT_STORE6(store_out, u_out)
+
+// The fallback faces: (voxel packed 10 bits an axis, face g, α_g bits, 0).
+layout(std430, binding = 5) buffer Fallback { uvec4 fallback[]; };
+
+vec3 face_point(ivec3 v, vec3 n) {   // the centre of v's face with outward normal n
+    vec3 centre = u_grid_origin + (vec3(v) + 0.5) * u_grid_cell;
+    return centre + n * (0.5 * u_grid_cell);
+}
+
+vec3 face_normal(int g) {
+    vec3 n = vec3(0.0);
+    n[g >> 1] = (g & 1) == 0 ? 1.0 : -1.0;
+    return n;
+}
+
+#if defined(MODE_FALLBACK)
+layout(local_size_x = 64) in;
+uniform uint u_first;   // this dispatch's first entry (at most 65535 groups a dispatch)
+uniform uint u_count;   // entries in the list
+
+void main() {
+    uint i = u_first + gl_GlobalInvocationID.x;
+    if (i >= u_count) return;
+    uvec4 f = fallback[i];
+    ivec3 v = ivec3(f.x & 1023u, (f.x >> 10) & 1023u, f.x >> 20);
+    int g = int(f.y);
+    vec3 n = face_normal(g);
+    vec3 p = face_point(v, n);
+    vec3 e = vec3(0.0);
+    for (int k = 0; k < u_light_count; ++k) e += light_irradiance(lights[k], p, n, n);
+    store_out(g, v, vec4(texelFetch(u_albedo, v, 0).rgb * e / PI, uintBitsToFloat(f.z)));
+}
+#else
+layout(std430, binding = 3) buffer Count { uint fallback_count; };   // gl/bind.dispatch_counted
+uniform uint u_capacity;   // entries the list holds: the count goes on past it (vct/inject.py makes it larger)
 
 float acc(int g, ivec3 v, int c) {
     return uintBitsToFloat(texelFetch(u_acc, ivec3(8 * v.x + c, v.y, g * u_grid_size.z + v.z), 0).r);
@@ -85,25 +126,23 @@ void main() {
     if (any(greaterThanEqual(v, u_grid_size))) return;
     vec4 area = texelFetch(u_area, v, 0);
     if (area.a <= 0.0) return;   // most voxels are empty, and the images start zeroed (vct._texture3d)
-    vec3 centre = u_grid_origin + (vec3(v) + 0.5) * u_grid_cell;
     float cell2 = u_grid_cell * u_grid_cell;
     for (int g = 0; g < 6; ++g) {
         int axis = g >> 1;
-        vec3 n = vec3(0.0);
-        n[axis] = (g & 1) == 0 ? 1.0 : -1.0;
+        vec3 n = face_normal(g);
         float alpha = min(1.0, column_area(v, axis, area[axis]) / cell2);
         vec3 radiance = vec3(0.0);
-        vec4 surface = vec4(centre + n * (0.5 * u_grid_cell), 0.0);
+        vec4 surface = vec4(face_point(v, n), 0.0);
         float w = acc(g, v, 3);
         if (alpha > 0.0 && w > 0.0) {
             radiance = vec3(acc(g, v, 0), acc(g, v, 1), acc(g, v, 2)) / w;
             surface = vec4(vec3(acc(g, v, 4), acc(g, v, 5), acc(g, v, 6)) / w, alpha);
         } else if (alpha > 0.0) {
-            // The centroid dispatch needs only where the face is, not its light.
+            // Lit by MODE_FALLBACK; the centroid dispatch needs only where the face is.
 #if !defined(WRITE_CENTROIDS)
-            vec3 e = vec3(0.0);
-            for (int i = 0; i < u_light_count; ++i) e += light_irradiance(lights[i], surface.xyz, n, n);
-            radiance = texelFetch(u_albedo, v, 0).rgb * e / PI;
+            uint i = atomicAdd(fallback_count, 1u);
+            if (i < u_capacity) fallback[i] = uvec4(uint(v.x) | (uint(v.y) << 10) | (uint(v.z) << 20), uint(g),
+                                                    floatBitsToUint(alpha), 0u);
 #endif
             surface.w = -alpha;
         }
@@ -114,4 +153,5 @@ void main() {
 #endif
     }
 }
+#endif
 #endif
