@@ -6,6 +6,9 @@
     vct_mipmap      ← injection, anisotropy
     vct_bounce      ← mipmaps, cone settings, bounces
     vct_specular    ← gbuffer, bounced volumes, specular settings
+    vct_hits        ← geometry, camera, emission, grid, trace settings: the per-pixel trace's hits
+                      (vct/replay.py), filled by the first vct_trace and replayed by the next ones (a light,
+                      world or material colour edit)
     vct_trace       ← gbuffer, bounced volumes, trace settings, accumulation frame
     vct_upsample    ← vct_trace (indirect_scale > 1)
     vct_accumulate  ← the upsampled trace (temporal_frames > 1)
@@ -16,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..common.method import MethodOutput
-from . import bounce, colours, inject, mipmap, specular, temporal, trace, upsample
+from . import bounce, colours, inject, mipmap, replay, specular, temporal, trace, upsample
 from .volumes import mip_levels, vct_grid, voxelize_scene
 
 # Outputs kept per pass (gl/pass_cache.py): the voxels of two grids (the live viewport's draft and final stages).
@@ -49,7 +52,7 @@ def run(frame) -> MethodOutput:
     glossy = cache.run("vct_specular", k_spec, lambda: specular.specular(ctx, programs, frame.gbuffer, faces,
                                                                          bounced, s))
     indirect, k_trace, extra = _per_pixel(frame, faces, bounced, (frame.keys["gbuffer"], k_bounce,
-                                                                          s.key("trace")))
+                                                                          s.key("trace")), (grid.key(), levels))
     info = {**trace.render_info(faces, bounced, s), "specular_pixels": glossy["traced"], **extra,
             "skipped_work": bounce.skipped_work(bounced.bounce_stats or [], s) + specular.skipped_work(glossy, s)}
     key, out = (k_trace, k_spec), (indirect, glossy["glossy"])
@@ -59,10 +62,13 @@ def run(frame) -> MethodOutput:
     return MethodOutput(*out, key, colours.scale_info(info, scale), has_ao=True)
 
 
-def _per_pixel(frame, faces, bounced, base):
+def _per_pixel(frame, faces, bounced, base, grid):
     """The per-pixel cones: trace, upsample (indirect_scale > 1), temporal accumulation (temporal_frames > 1).
     The trace's inputs (`base`) key the history; while it holds fewer than temporal_frames frames, the frame
-    index makes the keys new, so trace (and upsample) run again with the next jitter. Returns (texture, the
+    index makes the keys new, so trace (and upsample) run again with the next jitter. The trace records its hits
+    and replays them while what they depend on holds (vct_hits: the geometry, camera and traced size, `grid` = the
+    grid's key and levels, the trace settings; and the emission, which decides which emitters are closed shells,
+    common/emitters.py); not while accumulating, where every frame turns the cones. Returns (texture, the
     trace's key, the upsampling's and accumulation's statistics)."""
     ctx, programs, cache, s, gbuffer = frame.ctx, frame.programs, frame.cache, frame.settings.vct, frame.gbuffer
     accumulating = s.temporal_frames > 1
@@ -70,9 +76,14 @@ def _per_pixel(frame, faces, bounced, base):
     index = temporal.frame_index(prior.value if prior and accumulating else None, base, s.temporal_frames)
     rotation = temporal.jitter_deg(s, index) if accumulating else s.cone_rotation
     k_trace = (base, index)
+    hits = None
+    if s.anisotropic and not accumulating:
+        size, kept = trace.traced_size(gbuffer, s), cache.kept("vct_hits")
+        k_hits = tuple(frame.keys[k] for k in ("geometry", "camera", "emission")) + (size, grid, s.key("trace"))
+        hits = cache.run("vct_hits", k_hits, lambda: replay.allocate(ctx, size, kept[0][1] if kept else None))
     traced = cache.run("vct_trace", k_trace, lambda: trace.trace(ctx, programs, gbuffer, faces, bounced, s,
-                                                                 rotation))
-    info = {}
+                                                                 rotation, hits))
+    info = replay.stats(hits)
     indirect = traced["indirect"]
     if s.indirect_scale > 1:
         up = cache.run("vct_upsample", k_trace, lambda: upsample.upsample(

@@ -10,6 +10,7 @@ import numpy as np
 
 from ..common.grid import Grid
 from ..gl.bind import bind_grid, bind_samplers, dispatch, read_texture, set_uniform, set_uniforms, write_uniform
+from . import replay
 from .cones import MAX_CONES, cone_table, subray_radius
 from .settings import VctSettings
 from .volumes import ConeVolumes, Faces, bind_volumes
@@ -30,22 +31,38 @@ def bind_cones(prog, grid: Grid, levels: int, s: VctSettings) -> None:
                         "u_max_distance": float(s.max_distance), "u_ao_distance": float(s.ao_distance)})
 
 
+def traced_size(gbuffer, s: VctSettings) -> tuple:
+    """The texels vct_trace gathers at: ceil(W/s) × ceil(H/s) for s = indirect_scale."""
+    scale = int(s.indirect_scale)
+    return tuple(-(-int(n) // scale) for n in gbuffer.size)
+
+
 def trace(ctx, programs, gbuffer, faces: Faces, volumes: ConeVolumes, s: VctSettings,
-          rotation_deg: float | None = None) -> dict:
+          rotation_deg: float | None = None, hits: replay.TraceHits | None = None) -> dict:
     """Diffuse cones per G-buffer pixel, or per indirect_scale² block (vct/trace.glsl): {'indirect': RGBA32F
     texture of ceil(W/s) × ceil(H/s), rgb = Diffuse Indirect (irradiance/π), a = voxel AO; 'scale': s}. The cone
-    set is turned by `rotation_deg` about the normal (default s.cone_rotation)."""
+    set is turned by `rotation_deg` about the normal (default s.cone_rotation). `hits` (anisotropic volumes only,
+    vct/replay.py): an empty pool is filled with the trace's hits, a filled one replayed (the same image)."""
     scale = int(s.indirect_scale)
-    fw, fh = gbuffer.size
-    w, h = -(-fw // scale), -(-fh // scale)
+    w, h = traced_size(gbuffer, s)
     out = ctx.texture((w, h), 4, dtype="f4")
-    prog = trace_program(programs, gbuffer, faces, volumes, s, rotation_deg, fixup=False)
+    mode = None if hits is None else ("replay" if hits.recorded else "record")
+    prog = trace_program(programs, gbuffer, faces, volumes, s, rotation_deg, fixup=False, hits=mode)
     set_uniform(prog, "u_image_size", (w, h))
     set_uniform(prog, "u_scale", scale)
     out.bind_to_image(0, read=False, write=True)
-    dispatch(prog, (w, h), local=8)
-    ctx.memory_barrier()
-    return {"indirect": out, "scale": scale}
+    counter = replay.new_counter(ctx) if hits is not None else None
+    try:
+        if hits is not None:
+            replay.bind(prog, hits, counter)
+        dispatch(prog, (w, h), local=8)
+        ctx.memory_barrier()
+        if mode == "record":
+            hits.recorded, hits.needed = True, replay.read_count(counter)
+    finally:
+        if counter is not None:
+            counter.release()
+    return {"indirect": out, "scale": scale, "replayed": mode == "replay"}
 
 
 def fixup(ctx, programs, gbuffer, faces: Faces, volumes: ConeVolumes, s: VctSettings, texture,
@@ -60,13 +77,17 @@ def fixup(ctx, programs, gbuffer, faces: Faces, volumes: ConeVolumes, s: VctSett
     ctx.memory_barrier()
 
 
-def trace_program(programs, gbuffer, faces, volumes, s, rotation_deg, fixup: bool):
+def trace_program(programs, gbuffer, faces, volumes, s, rotation_deg, fixup: bool, hits: str | None = None):
     # Anisotropic volumes carry the layer volume the sub-rays need to find where surfaces lie (vct/crossing.glsl).
     defines = {"MODE_ANISO": None, "MODE_CROSSING": None, "SUBRAYS": int(s.subrays)} if volumes.anisotropic else {}
     if fixup:
         defines["MODE_FIXUP"] = None
+    if hits is not None:  # vct/hits.glsl
+        defines["MODE_RECORD" if hits == "record" else "MODE_REPLAY"] = None
     prog = programs.compute("vct/trace.glsl", defines or None)
     unit = bind_volumes(prog, volumes, 0)
+    for i in range(len(volumes.textures)):  # MODE_REPLAY reads them under other names (vct/trace.glsl)
+        set_uniform(prog, f"u_replay{i}", i)
     unit = bind_samplers(prog, "u_centroid", faces.centroids, unit)
     for name in ("position", "normal", "geo_normal"):
         unit = bind_samplers(prog, f"u_{name}", [gbuffer.textures[name]], unit)

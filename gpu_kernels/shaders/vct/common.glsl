@@ -201,6 +201,9 @@ vec4 gather_irradiance(vec3 p, vec3 n, vec3 n_geo, vec2 rot) {
         vec4 c = u_cones[k];
         vec2 xy = vec2(rot.x * c.x - rot.y * c.y, rot.y * c.x + rot.x * c.y);
         vec3 d = normalize(t1 * xy.x + t2 * xy.y + n * c.z);
+#if defined(MODE_RECORD)
+        g_cone = k;
+#endif
 #if defined(MODE_CROSSING)
         ConeResult r = trace_cone_crossing(o, d, u_cone_tan[k]);
 #else

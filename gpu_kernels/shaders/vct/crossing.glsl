@@ -37,6 +37,7 @@
 // (VctSettings.subrays).
 #pragma once
 #if defined(MODE_CROSSING)
+#include "vct/hits.glsl"
 
 #if !defined(SUBRAYS)
 #define SUBRAYS 7                 // the axis and SUBRAYS − 1 rays around it (a define: loops of constant length
@@ -168,7 +169,10 @@ ConeResult trace_cone_crossing(vec3 o, vec3 d, float tan_half) {
                                             : textureLod(u_volume[2 * a + 1], q, hit_lod);
                         if (s.a <= 0.0) continue;
                         float alpha = min(1.0 - exp(-s.a), T[j]);
-                        r.radiance += inv_ns * alpha * s.rgb / s.a;
+                        r.radiance += inv_ns * alpha * s.rgb / s.a;   // vct/hits.glsl replays this term
+#if defined(MODE_RECORD)
+                        record_hit(q, hit_lod, m[a] > 0.0 ? 2 * a : 2 * a + 1, alpha);
+#endif
                         T[j] -= alpha;
                     }
                 }

@@ -10,6 +10,8 @@
 // neighbours'.
 // MODE_FIXUP: full resolution, in place: only pixels vct/upsample.glsl marked (a < 0: no low-resolution sample lies
 // on their surface) are traced; the rest keep their upsampled value.
+// MODE_RECORD: the trace, keeping every texel's sub-ray hits (vct/hits.glsl); MODE_REPLAY: the same image from
+// those hits and the current volumes, a texel the record could not keep traced again.
 #include "vct/common.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -26,9 +28,61 @@ layout(rgba32f, binding = 0) uniform image2D u_indirect;
 layout(rgba32f, binding = 0) uniform writeonly image2D u_indirect;
 #endif
 
+#if defined(MODE_REPLAY)
+// The six volumes again, on the units of u_volume (vct/trace.py): read through a switch (the volume differs between
+// lanes, vct/arrays.glsl) of u_volume's own elements, llvmpipe (Mesa 22) got the sub-rays' u_volume[2 * a] wrong in
+// the texels this program traces again.
+uniform sampler3D u_replay0, u_replay1, u_replay2, u_replay3, u_replay4, u_replay5;
+vec4 volume_at(uint i, vec3 q, float lod) {
+    switch (i) {
+        case 0u: return textureLod(u_replay0, q, lod); case 1u: return textureLod(u_replay1, q, lod);
+        case 2u: return textureLod(u_replay2, q, lod); case 3u: return textureLod(u_replay3, q, lod);
+        case 4u: return textureLod(u_replay4, q, lod); default: return textureLod(u_replay5, q, lod);
+    }
+}
+
+// The texel's Diffuse Indirect as trace_cone_crossing and gather_irradiance sum it, term by term in their order.
+vec3 replay(uvec4 header) {
+    const float inv_ns = 1.0 / float(SUBRAYS);
+    vec3 e = vec3(0.0), radiance = vec3(0.0);
+    int cone = 0;
+    uint chunk = header.x;
+    for (uint h = 0u; h < header.y; ++h) {
+        if (h > 0u && h % HIT_CHUNK == 0u) chunk = hit_next[chunk];
+        uint i = chunk * HIT_CHUNK + h % HIT_CHUNK;
+        vec4 point = hit_points[i];
+        uint tag = hit_tags[i];
+        for (; cone < int(tag & 31u); ++cone) {
+            e += u_cones[cone].w * radiance;
+            radiance = vec3(0.0);
+        }
+        vec4 s = volume_at((tag >> 5) & 7u, point.xyz, float(tag >> 8));
+        float alpha = point.w;
+        radiance += inv_ns * alpha * s.rgb / s.a;
+    }
+    for (; cone < u_cone_count; ++cone) {
+        e += u_cones[cone].w * radiance;
+        radiance = vec3(0.0);
+    }
+    return e;
+}
+#endif
+
 void main() {
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(px, u_image_size))) return;
+    uint texel = uint(px.y * u_image_size.x + px.x);
+#if defined(MODE_REPLAY)
+    uvec4 header = hit_headers[texel];
+    if (header.w == HIT_BACKGROUND) {
+        imageStore(u_indirect, px, vec4(0.0));
+        return;
+    }
+    if (header.w == HIT_RECORDED) {
+        imageStore(u_indirect, px, vec4(replay(header) / VCT_PI, uintBitsToFloat(header.z)));
+        return;
+    }
+#endif
 #if defined(MODE_FIXUP)
     if (imageLoad(u_indirect, px).a >= 0.0) return;
     ivec2 src = px;
@@ -37,11 +91,18 @@ void main() {
 #endif
     vec4 pos = texelFetch(u_position, src, 0);
     if (pos.w < 0.5) {
+#if defined(MODE_RECORD)
+        hit_headers[texel] = uvec4(0u, 0u, 0u, HIT_BACKGROUND);
+#endif
         imageStore(u_indirect, px, vec4(0.0));
         return;
     }
     vec3 n = normalize(texelFetch(u_normal, src, 0).xyz);
     vec3 geo_n = normalize(texelFetch(u_geo_normal, src, 0).xyz);
     vec4 e = gather_irradiance(pos.xyz, n, geo_n, u_rotation);
-    imageStore(u_indirect, px, vec4(e.rgb / VCT_PI, e.a));
+    vec4 value = vec4(e.rgb / VCT_PI, e.a);
+#if defined(MODE_RECORD)
+    hit_headers[texel] = uvec4(g_first, g_hits, floatBitsToUint(value.a), g_overflow ? 0u : HIT_RECORDED);
+#endif
+    imageStore(u_indirect, px, value);
 }

@@ -1,0 +1,55 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The per-pixel sub-rays' hits, recorded once and replayed after a light or world edit (vct/replay.py).
+//
+// Why it is exact: with the geometry, the camera and the trace settings fixed, everything a sub-ray does but the
+// radiance it reads depends on the volumes' optical depths and the layer volume alone (vct/crossing.glsl): where it
+// steps, which texels it crosses, how much of it each crossing absorbs (α = min(1 − e^−τ, T_j)). A light edit
+// changes the volumes' τ·S and nothing else, so a pixel's Diffuse Indirect is the same sum of the same terms,
+// (1/N)·α·(τ·S)/τ read at the same point of the same volume and level, per cone, weighted by the cone's w — the
+// cached "per-receiver weights of each cone sample" of Enlighten-style precomputed transport, kept per pixel.
+// A replay sums them in the order the trace did, so it gives the trace's image bit for bit.
+//
+// Layout: each traced texel's hits in chunks of HIT_CHUNK slots taken from a shared pool with an atomic counter
+// (binding 3; the counter goes on past the pool's capacity, so the pass that recorded knows how many it needed);
+// a chunk's slots hold (q.xyz, α) and a tag (cone | volume << 5 | level << 8), the chunk after it is `next`.
+// header = (first chunk, hits, the texel's AO bits, state): state 1 recorded, 2 background, 0 not recorded (the
+// pool ran out: a replay traces that texel again).
+#pragma once
+
+#define HIT_CHUNK 16u
+#define HIT_RECORDED 1u
+#define HIT_BACKGROUND 2u
+
+layout(std430, binding = 3) buffer HitCount { uint chunk_count; };
+layout(std430, binding = 4) buffer HitHeaders { uvec4 hit_headers[]; };
+layout(std430, binding = 5) buffer HitPoints { vec4 hit_points[]; };   // q (texture coordinates), α
+layout(std430, binding = 6) buffer HitTags { uint hit_tags[]; };
+layout(std430, binding = 7) buffer HitNext { uint hit_next[]; };        // per chunk
+uniform uint u_chunk_capacity;
+
+#if defined(MODE_RECORD)
+int g_cone = 0;            // the cone being traced (vct/common.glsl gather_irradiance sets it)
+int g_chunk = -1;          // this texel's current chunk
+uint g_first = 0u, g_slot = 0u, g_hits = 0u;
+bool g_overflow = false;
+
+void record_hit(vec3 q, float lod, int volume, float alpha) {
+    if (g_overflow) return;
+    if (g_chunk < 0 || g_slot == HIT_CHUNK) {
+        uint c = atomicAdd(chunk_count, 1u);
+        if (c >= u_chunk_capacity) {
+            g_overflow = true;
+            return;
+        }
+        if (g_chunk < 0) g_first = c;
+        else hit_next[g_chunk] = c;
+        g_chunk = int(c);
+        g_slot = 0u;
+    }
+    uint i = uint(g_chunk) * HIT_CHUNK + g_slot;
+    hit_points[i] = vec4(q, alpha);
+    hit_tags[i] = uint(g_cone) | (uint(volume) << 5) | (uint(lod) << 8);
+    g_slot += 1u;
+    g_hits += 1u;
+}
+#endif
