@@ -13,13 +13,15 @@ from .inject import face_flux
 from .mipmap import build_volumes
 from .settings import VctSettings
 from .trace import bind_cones
-from .volumes import ConeVolumes, Faces, bind_volumes, gather_levels
+from .volumes import ConeVolumes, Faces, VoxelGeometry, bind_volumes, gather_levels
 
 
-def bounce(ctx, programs, vox, direct_faces: Faces, volumes: ConeVolumes, s: VctSettings) -> ConeVolumes:
+def bounce(ctx, programs, vox, direct_faces: Faces, volumes: ConeVolumes, s: VctSettings,
+           shared: VoxelGeometry | None = None) -> ConeVolumes:
     """bounces − 1 gathers at the voxel faces (vct/bounce.glsl), each followed by a re-mip. Returns the volumes
     the final gather reads (a non-owning view of `volumes` when bounces = 1); `bounce_stats` lists the flux the
-    faces carry after each bounce (bounce 1 = direct light reflected once)."""
+    faces carry after each bounce (bounce 1 = direct light reflected once). The list of faces to gather is taken
+    from `shared` where it holds one, else made and left there."""
     stats = [{"bounce": 1, "flux": direct_faces.flux}]
     gathered = s.bounces if not s.gathered_bounces else min(s.gathered_bounces, s.bounces)
     if gathered <= 1 or _total(stats[0]) <= 0.0:  # one bounce, or no light reached a voxel: nothing to gather
@@ -27,7 +29,9 @@ def bounce(ctx, programs, vox, direct_faces: Faces, volumes: ConeVolumes, s: Vct
                            bounce_stats=stats, layers=volumes.layers, layers_owned=False)
     grid = direct_faces.grid
     faces = Faces([texture3d(ctx, grid.size, zero=True) for _ in range(6)], grid, direct_faces.levels)
-    listed, count = face_list(ctx, programs, direct_faces)
+    if shared is not None and shared.face_list is None:
+        shared.face_list = face_list(ctx, programs, direct_faces)
+    listed, count = shared.face_list if shared is not None else face_list(ctx, programs, direct_faces)
     prog = programs.compute("vct/bounce.glsl", {"MODE_ANISO": None} if volumes.anisotropic else None)
     own, source, previous = None, volumes, None
     for b in range(2, gathered + 1):
@@ -50,7 +54,8 @@ def bounce(ctx, programs, vox, direct_faces: Faces, volumes: ConeVolumes, s: Vct
         if _total(stats[-1]) - _total(stats[-2]) < s.epsilon * _total(stats[0]):
             stats[-1]["stopped"] = True  # the series ends here: no further gather, no tail
             break
-    listed.release()
+    if shared is None:
+        listed.release()
     if previous is not None and stats[-1].get("stopped"):
         if previous is not direct_faces:
             previous.release()

@@ -15,22 +15,26 @@ from ..direct.geometry import POSITION_ONLY, POSITION_UV, draw_by_material
 from ..gl.bind import (VOLUME_GROUP, bind_grid, bind_lights, bind_samplers, dispatch, dispatch_counted, set_uniform,
                        set_uniforms, texture3d, zero_texture)
 from ..scene import Scene
-from .volumes import Faces
+from .volumes import Faces, VoxelGeometry
 
 
 INJECT_SAMPLES = 2  # raster samples per voxel edge: ~4 surface points per voxel face; slivers fall back (vct_inject)
 COVER_TEST_BYTES = 256 * 2 ** 20  # the front-most images' budget (32 MiB at 64³); larger grids skip the cover test
 
 
-def inject(ctx, programs, scene: Scene, geometry, textures: list, vox, shadows, levels: int) -> Faces:
+def inject(ctx, programs, scene: Scene, geometry, textures: list, vox, shadows, levels: int,
+           shared: VoxelGeometry | None = None) -> Faces:
     """Direct light reflected through every voxel face: surface points rasterised along their dominant axis and lit
-    exactly as in direct/light.glsl (vct/inject_raster.glsl), then averaged per face (vct/inject.glsl)."""
+    exactly as in direct/light.glsl (vct/inject_raster.glsl), then averaged per face (vct/inject.glsl). The faces'
+    centroids are taken from `shared` where it holds them, else made and left there."""
     import moderngl
 
     grid = vox.grid
     nx, ny, nz = grid.size
+    kept = shared is not None and shared.centroids is not None
     faces = Faces([texture3d(ctx, grid.size, zero=True) for _ in range(6)], grid, levels,
-                  centroids=[texture3d(ctx, grid.size, zero=True) for _ in range(6)])
+                  centroids=shared.centroids if kept else [texture3d(ctx, grid.size, zero=True) for _ in range(6)],
+                  centroids_owned=not kept)
     acc = ctx.texture3d((8 * nx, ny, 6 * nz), 1, dtype="u4")
     acc.filter = (moderngl.NEAREST, moderngl.NEAREST)
     try:
@@ -59,7 +63,8 @@ def inject(ctx, programs, scene: Scene, geometry, textures: list, vox, shadows, 
             for t in fronts:
                 t.release()
 
-        for outputs, defines in ((faces.textures, {}), (faces.centroids, {"WRITE_CENTROIDS": None})):
+        for outputs, defines in ((faces.textures, {}),) + (() if kept else ((faces.centroids,
+                                                                              {"WRITE_CENTROIDS": None}),)):
             prog = _resolve_program(programs, {"MODE_RESOLVE": None, **defines}, vox, acc, shadows, grid, outputs)
             if defines:
                 dispatch(prog, grid.size)
@@ -69,6 +74,8 @@ def inject(ctx, programs, scene: Scene, geometry, textures: list, vox, shadows, 
     finally:
         acc.release()
     faces.flux, faces.occupied, faces.missed = face_flux(ctx, programs, faces)
+    if shared is not None and not kept:
+        shared.centroids, faces.centroids_owned = faces.centroids, False
     return faces
 
 

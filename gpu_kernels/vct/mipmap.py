@@ -5,14 +5,15 @@ and the layer volume that says where each texel's surfaces lie along each axis."
 from __future__ import annotations
 
 from ..gl.bind import bind_grid, bind_images, bind_samplers, dispatch, set_uniform, texture3d
-from .volumes import ConeVolumes, Faces, level_sizes
+from .volumes import ConeVolumes, Faces, VoxelGeometry, level_sizes
 
 
 def build_volumes(ctx, programs, faces: Faces, anisotropic: bool, into: ConeVolumes | None = None,
-                  layers=None) -> ConeVolumes:
+                  layers=None, shared: VoxelGeometry | None = None) -> ConeVolumes:
     """Level 0 from the face radiances, then each level from the one below (vct/mipmap.glsl, Freed 2018, §4.4), and,
-    anisotropic, the layer volume (from faces.centroids, or `layers` shared from the volumes of the same geometry).
-    `into`: rebuild existing volumes in place (the vct_bounce pass) instead of allocating new ones."""
+    anisotropic, the layer volume (from faces.centroids, or `layers` shared from the volumes of the same geometry,
+    or `shared`'s, which gets it where it has none). `into`: rebuild existing volumes in place (the vct_bounce pass)
+    instead of allocating new ones."""
     grid = faces.grid
     sizes = level_sizes(grid, faces.levels)
     count = 6 if anisotropic else 1
@@ -33,10 +34,13 @@ def build_volumes(ctx, programs, faces: Faces, anisotropic: bool, into: ConeVolu
         set_uniform(prog, "u_level", level)
         dispatch(prog, sizes[level])
         ctx.memory_barrier()
+    layers = shared.layers if layers is None and shared is not None else layers
     if anisotropic and layers is not None:
         vols.layers, vols.layers_owned = layers, False
     elif anisotropic and vols.layers is None:
-        vols.layers, vols.layers_owned = build_layers(ctx, programs, faces, vols), True
+        vols.layers, vols.layers_owned = build_layers(ctx, programs, faces, vols), shared is None
+        if shared is not None:
+            shared.layers = vols.layers
     return vols
 
 

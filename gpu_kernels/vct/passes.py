@@ -2,6 +2,9 @@
 """The VCT's passes in the pipeline's pass cache (pipeline.METHOD_PASSES["vct"]):
 
     vct_voxelize    ← geometry, materials, grid
+    vct_geometry    ← geometry, emission, grid, levels: what the passes below derive from the geometry alone, made
+                      by the first that needs each part and kept across light, world and material colour edits
+                      (volumes.VoxelGeometry)
     vct_inject      ← voxels, shadow maps, the lights per unit of the largest colour (vct/colours.py)
     vct_mipmap      ← injection, anisotropy
     vct_bounce      ← mipmaps, cone settings, bounces
@@ -20,7 +23,7 @@ import numpy as np
 
 from ..common.method import MethodOutput
 from . import bounce, colours, inject, mipmap, replay, specular, temporal, trace, upsample
-from .volumes import mip_levels, vct_grid, voxelize_scene
+from .volumes import VoxelGeometry, mip_levels, vct_grid, voxelize_scene
 
 # Outputs kept per pass (gl/pass_cache.py): the voxels of two grids (the live viewport's draft and final stages).
 KEEP = {"vct_voxelize": 2}
@@ -39,15 +42,18 @@ def run(frame) -> MethodOutput:
     # follows, and only the results are scaled back.
     scale = colours.colour_scale(frame.shadows)
     records = colours.unit_records(frame.shadows, scale)
+    shared = cache.run("vct_geometry", (frame.keys["geometry"], frame.keys["emission"], grid.key(), levels),
+                       VoxelGeometry)
     k_inject = (k_vox, colours.unit_key(frame.shadows, records), levels)
     faces = cache.run("vct_inject", k_inject, lambda: colours.with_records(
         ctx, frame.shadows, records, lambda shadows: inject.inject(ctx, programs, scene, frame.geometry,
-                                                                   frame.textures, vox, shadows, levels)))
+                                                                   frame.textures, vox, shadows, levels, shared)))
     k_mip = (k_inject, s.anisotropic)
-    volumes = cache.run("vct_mipmap", k_mip, lambda: mipmap.build_volumes(ctx, programs, faces, s.anisotropic))
+    volumes = cache.run("vct_mipmap", k_mip, lambda: mipmap.build_volumes(ctx, programs, faces, s.anisotropic,
+                                                                         shared=shared))
     k_bounce = (k_mip, s.key("bounce"))
     bounced = cache.run("vct_bounce", k_bounce,
-                        lambda: bounce.bounce(ctx, programs, vox, faces, volumes, s))
+                        lambda: bounce.bounce(ctx, programs, vox, faces, volumes, s, shared))
     k_spec = (frame.keys["gbuffer"], k_bounce, s.key("specular"))
     glossy = cache.run("vct_specular", k_spec, lambda: specular.specular(ctx, programs, frame.gbuffer, faces,
                                                                          bounced, s))

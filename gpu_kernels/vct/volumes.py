@@ -62,9 +62,26 @@ class Faces:
     occupied: int = 0
     centroids: list = None  # vct/inject.py only: per face, xyz = where its surface points lie, w = ±α_g
     missed: int = 0  # faces with coverage that caught no raster sample (lit at the face centre instead)
+    centroids_owned: bool = True  # False: VoxelGeometry's, kept across light edits
 
     def release(self):
-        for t in self.textures + (self.centroids or []):
+        for t in self.textures + (self.centroids or [] if self.centroids_owned else []):
+            t.release()
+
+
+@dataclass
+class VoxelGeometry:
+    """What the VCT passes derive from the geometry alone (the vct_geometry pass, keyed by the geometry, the
+    emission, the grid and its levels), made by the first frame that needs each and kept across light, world and
+    material colour edits, which would make them again the same: the faces' centroids (vct/inject.py), the layer
+    volumes (vct/mipmap.py) and the list of faces with coverage (vct/bounce.py). The passes' outputs that read them
+    do not own them."""
+    centroids: list = None
+    layers: object = None
+    face_list: tuple = None  # (storage buffer, count)
+
+    def release(self):
+        for t in (self.centroids or []) + [self.layers] * (self.layers is not None) + list(self.face_list or ())[:1]:
             t.release()
 
 
