@@ -21,7 +21,9 @@ HIT_CHUNK = 16  # slots per chunk (vct/hits.glsl HIT_CHUNK)
 # (16 cones × 5 sub-rays): Cornell box mean 122, max 214; window_room 116 / 185; outdoor 70 / 247; furnished
 # 156 / 406 — the pool is shared, so a texel with many hits takes what others leave.
 CHUNKS_PER_TEXEL = 16
-BUDGET_BYTES = 256 * 2 ** 20  # the pool's cap: about 2.6 × 10⁵ traced texels at CHUNKS_PER_TEXEL
+# The pool's cap (as the LPV's transfer_mb): 1.0 × 10⁵ traced texels at CHUNKS_PER_TEXEL, about twice as many once
+# sized from a prior record (a 1280 × 640 image at indirect_scale 2).
+BUDGET_BYTES = 512 * 2 ** 20
 SLOT_BYTES = 16 + 4  # a point (q, α) and a tag
 CHUNK_BYTES = HIT_CHUNK * SLOT_BYTES + 4  # and the index of the next chunk
 HEADER_BYTES = 16
@@ -57,7 +59,10 @@ def allocate(ctx, size: tuple, prior: TraceHits | None = None, budget: int | Non
     per_texel = float(CHUNKS_PER_TEXEL)
     if prior is not None and prior.recorded and prior.needed <= prior.capacity:
         per_texel = min(per_texel, 1.25 * prior.needed / max(prior.size[0] * prior.size[1], 1) + 1.0)
-    capacity = max(1, min(int(per_texel * texels), (budget - HEADER_BYTES * texels) // CHUNK_BYTES))
+    # A storage block's size is capped too (128 MiB on llvmpipe): the points' buffer must fit in one.
+    block = int(ctx.info.get("GL_MAX_SHADER_STORAGE_BLOCK_SIZE", 2 ** 27))
+    capacity = max(1, min(int(per_texel * texels), (budget - HEADER_BYTES * texels) // CHUNK_BYTES,
+                          block // (16 * HIT_CHUNK)))
     slots = capacity * HIT_CHUNK
     return TraceHits(ctx.buffer(reserve=HEADER_BYTES * texels), ctx.buffer(reserve=16 * slots),
                      ctx.buffer(reserve=4 * slots), ctx.buffer(reserve=4 * capacity), tuple(size), capacity)
