@@ -25,8 +25,9 @@ from ..common.method import MethodOutput
 from . import bounce, colours, inject, mipmap, replay, specular, temporal, trace, upsample
 from .volumes import VoxelGeometry, mip_levels, vct_grid, voxelize_scene
 
-# Outputs kept per pass (gl/pass_cache.py): the voxels of two grids (the live viewport's draft and final stages).
-KEEP = {"vct_voxelize": 2}
+# Outputs kept per pass (gl/pass_cache.py): the voxels, what their geometry decides and the per-pixel hits of two
+# grids and G-buffers (the live viewport's draft and final stages, which alternate after every edit).
+KEEP = {"vct_voxelize": 2, "vct_geometry": 2, "vct_hits": 2}
 
 
 def run(frame) -> MethodOutput:
@@ -84,9 +85,11 @@ def _per_pixel(frame, faces, bounced, base, grid):
     k_trace = (base, index)
     hits = None
     if s.anisotropic and not accumulating:
-        size, kept = trace.traced_size(gbuffer, s), cache.kept("vct_hits")
+        size = trace.traced_size(gbuffer, s)
         k_hits = tuple(frame.keys[k] for k in ("geometry", "camera", "emission")) + (size, grid, s.key("trace"))
-        hits = cache.run("vct_hits", k_hits, lambda: replay.allocate(ctx, size, kept[0][1] if kept else None))
+        # sized from the last record with the same cones (the viewport's draft stage traces fewer)
+        prior = next((v for k, v in cache.kept("vct_hits") if k[-1] == k_hits[-1]), None)
+        hits = cache.run("vct_hits", k_hits, lambda: replay.allocate(ctx, size, prior))
     traced = cache.run("vct_trace", k_trace, lambda: trace.trace(ctx, programs, gbuffer, faces, bounced, s,
                                                                  rotation, hits))
     info = replay.stats(hits)

@@ -105,3 +105,23 @@ def test_moving_geometry_or_the_camera_records_anew(edit):
         assert after.capacity == int((1.25 * before.needed / (20 * 15) + 1.0) * 20 * 15)
     finally:
         engine.shutdown()
+
+
+def test_the_viewport_stages_replay_after_a_light_move():
+    """The live viewport renders a draft (coarser grid) and a final stage on surface atlases after every edit: each
+    stage's hits are kept through the other's, so after a light move both replay."""
+    from bounce_gi.ui.live import draft_settings
+
+    final = RenderSettings("vct", 64, 64, vct=VctSettings(resolution=32))
+    draft = draft_settings(final)
+    assert draft.vct != final.vct  # fewer cones and sub-rays (and a coarser grid at larger resolutions)
+    engine = Engine()
+    try:
+        for scene in (_room(), _room(lamp=(0.5, -0.4, 1.2))):
+            replayed = []
+            for settings, budget in ((draft, 4096), (final, 16384)):
+                engine.submit_surface(scene, settings, budget).result()
+                replayed.append(engine.pipeline.cache.entries["vct_trace"].value["replayed"])
+        assert replayed == [True, True]
+    finally:
+        engine.shutdown()
