@@ -9,6 +9,7 @@ import numpy as np
 
 from ..common.bounce_tail import tail_ratio, tail_sum
 from ..gl.bind import VOLUME_GROUP, bind_samplers, dispatch, dispatch_counted, set_uniform, texture3d
+from . import replay
 from .inject import face_flux
 from .mipmap import build_volumes
 from .settings import VctSettings
@@ -32,23 +33,17 @@ def bounce(ctx, programs, vox, direct_faces: Faces, volumes: ConeVolumes, s: Vct
     if shared is not None and shared.face_list is None:
         shared.face_list = face_list(ctx, programs, direct_faces)
     listed, count = shared.face_list if shared is not None else face_list(ctx, programs, direct_faces)
-    prog = programs.compute("vct/bounce.glsl", {"MODE_ANISO": None} if volumes.anisotropic else None)
+    pool = gather_pool(ctx, shared, count, s) if shared is not None and volumes.anisotropic else None
     own, source, previous = None, volumes, None
     for b in range(2, gathered + 1):
         if b == gathered and gathered < s.bounces:  # the tail needs the last increment L_K − L_(K−1): keep L_(K−1)
             previous = faces if b > 2 else direct_faces
             if b > 2:
                 faces = Faces([texture3d(ctx, grid.size, zero=True) for _ in range(6)], grid, direct_faces.levels)
-        unit = bind_volumes(prog, source, 0)
-        unit = bind_samplers(prog, "u_direct", direct_faces.textures, unit)
-        unit = bind_samplers(prog, "u_centroid", direct_faces.centroids, unit)
-        bind_samplers(prog, "u_albedo", [vox.albedo], unit)
-        bind_cones(prog, grid, min(volumes.levels, gather_levels(s.resolution)),
-                   replace(s, diffuse_cones=s.bounce_cones or s.diffuse_cones))
+        prog = gather_program(programs, source, direct_faces, vox, s, pool)
         for i, t in enumerate(faces.textures):
             t.bind_to_image(i, read=False, write=True)
-        gather_listed(prog, listed, count)
-        ctx.memory_barrier()
+        gather_listed(ctx, prog, listed, count, pool)
         own = source = build_volumes(ctx, programs, faces, volumes.anisotropic, into=own, layers=volumes.layers)
         stats.append({"bounce": b, "flux": face_flux(ctx, programs, faces)[0]})
         if _total(stats[-1]) - _total(stats[-2]) < s.epsilon * _total(stats[0]):
@@ -94,13 +89,54 @@ def face_list(ctx, programs, faces: Faces, capacity: int | None = None) -> tuple
     return listed, count
 
 
-def gather_listed(prog, listed, count: int) -> None:
-    """vct/bounce.glsl over the `count` faces of `listed` (face_list), one per invocation."""
+def gather_program(programs, source: ConeVolumes, direct_faces: Faces, vox, s: VctSettings, pool=None):
+    """vct/bounce.glsl's gathers from `source`, bound (MODE_RECORD_GATHER / MODE_REPLAY_GATHER with a `pool`)."""
+    defines = {"MODE_ANISO": None} if source.anisotropic else {}
+    if pool is not None:
+        defines["MODE_REPLAY_GATHER" if pool.recorded else "MODE_RECORD_GATHER"] = None
+    prog = programs.compute("vct/bounce.glsl", defines or None)
+    unit = bind_volumes(prog, source, 0)
+    for i in range(len(source.textures)):  # MODE_REPLAY_GATHER reads them under other names too
+        set_uniform(prog, f"u_replay{i}", i)
+    unit = bind_samplers(prog, "u_direct", direct_faces.textures, unit)
+    unit = bind_samplers(prog, "u_centroid", direct_faces.centroids, unit)
+    bind_samplers(prog, "u_albedo", [vox.albedo], unit)
+    bind_cones(prog, source.grid, min(source.levels, gather_levels(s.resolution)),
+               replace(s, diffuse_cones=s.bounce_cones or s.diffuse_cones))
+    return prog
+
+
+def gather_pool(ctx, shared: VoxelGeometry, count: int, s: VctSettings) -> replay.HitPool:
+    """The gathers' steps kept with the geometry's parts (vct/hits.glsl GatherStep): the one made under the same
+    cone settings, or a new, empty one (the next gather records into it)."""
+    key = (count, s.key("bounce"))
+    if shared.gather_pool is None or shared.gather_pool.key != key:
+        if shared.gather_pool is not None:
+            shared.gather_pool.release()
+        shared.gather_pool = replay.allocate(ctx, (count,), slots=replay.GATHER_SLOTS,
+                                             per_item=replay.CHUNKS_PER_FACE)
+        shared.gather_pool.key = key
+    return shared.gather_pool
+
+
+def gather_listed(ctx, prog, listed, count: int, pool: replay.HitPool | None = None) -> None:
+    """vct/bounce.glsl over the `count` faces of `listed` (face_list), one per invocation; with a `pool`, recorded
+    into it (and marked recorded) or replayed from it."""
     listed.bind_to_storage_buffer(5)
     set_uniform(prog, "u_face_count", count)
-    for first in range(0, count, FACES_PER_DISPATCH):
-        set_uniform(prog, "u_face_first", first)
-        dispatch(prog, (min(FACES_PER_DISPATCH, count - first),), 64)
+    counter = replay.new_counter(ctx) if pool is not None else None
+    try:
+        if pool is not None:
+            replay.bind(prog, pool, counter)
+        for first in range(0, count, FACES_PER_DISPATCH):
+            set_uniform(prog, "u_face_first", first)
+            dispatch(prog, (min(FACES_PER_DISPATCH, count - first),), 64)
+        ctx.memory_barrier()
+        if pool is not None and not pool.recorded:
+            pool.recorded, pool.needed = True, replay.read_count(counter)
+    finally:
+        if counter is not None:
+            counter.release()
 
 
 def _total(stat: dict) -> float:

@@ -21,59 +21,81 @@ HIT_CHUNK = 16  # slots per chunk (vct/hits.glsl HIT_CHUNK)
 # (16 cones × 5 sub-rays): Cornell box mean 122, max 214; window_room 116 / 185; outdoor 70 / 247; furnished
 # 156 / 406 — the pool is shared, so a texel with many hits takes what others leave.
 CHUNKS_PER_TEXEL = 16
-# The pool's cap (as the LPV's transfer_mb): 1.0 × 10⁵ traced texels at CHUNKS_PER_TEXEL, about twice as many once
+# Chunks a bounce gather's face may take on average: 48 steps. Measured, the Cornell box's 60 796 faces: 28.7 steps
+# that absorbed light a face (of 94 taken), 6 cones.
+CHUNKS_PER_FACE = 3
+# A pool's cap (as the LPV's transfer_mb): 1.0 × 10⁵ traced texels at CHUNKS_PER_TEXEL, about twice as many once
 # sized from a prior record (a 1280 × 640 image at indirect_scale 2).
 BUDGET_BYTES = 512 * 2 ** 20
-SLOT_BYTES = 16 + 4  # a point (q, α) and a tag
-CHUNK_BYTES = HIT_CHUNK * SLOT_BYTES + 4  # and the index of the next chunk
 HEADER_BYTES = 16
+# Bytes a slot takes, per storage buffer binding (vct/hits.glsl): the trace's hit (q, α) and tag, a gather's step.
+TRACE_SLOTS = {5: 16, 6: 4}
+GATHER_SLOTS = {6: 48}
 
 
 @dataclass
-class TraceHits:
-    """The hit pool of one traced image of `size` texels (vct/hits.glsl's buffers 4–7). `recorded`: a trace has
-    filled it; `needed`: the chunks that trace asked for (more than `capacity`: some texels are traced again)."""
+class HitPool:
+    """Records of `items` items (traced texels, or faces a bounce gathers at) in chunks (vct/hits.glsl): headers
+    on storage buffer 4, the chunks' links on 7, the records on `payload` (binding → buffer). `recorded`: a pass has
+    filled it; `needed`: the chunks it asked for (more than `capacity`: some items were not kept and run again);
+    `key`: what the records were made under, where the pool's holder does not key it."""
     headers: object
-    points: object
-    tags: object
+    payload: dict
     next: object
     size: tuple
     capacity: int
     recorded: bool = False
     needed: int = 0
+    key: object = None
+
+    @property
+    def items(self) -> int:
+        return int(np.prod(self.size))
 
     @property
     def nbytes(self) -> int:
-        return sum(b.size for b in (self.headers, self.points, self.tags, self.next))
+        return sum(b.size for b in (self.headers, self.next, *self.payload.values()))
 
     def release(self) -> None:
-        for b in (self.headers, self.points, self.tags, self.next):
+        for b in (self.headers, self.next, *self.payload.values()):
             b.release()
 
 
-def allocate(ctx, size: tuple, prior: TraceHits | None = None, budget: int | None = None) -> TraceHits:
-    """An empty pool for a traced image of `size` = (w, h) texels: CHUNKS_PER_TEXEL chunks a texel, or, after
-    a `prior` record that kept every texel (the last view of the scene), a quarter more than it needed a texel."""
-    texels = int(size[0]) * int(size[1])
+TraceHits = HitPool  # the per-pixel trace's pool (vct_hits)
+
+
+def chunk_bytes(slots: dict) -> int:
+    """A chunk's bytes: its slots' records and the link to the next chunk."""
+    return HIT_CHUNK * sum(slots.values()) + 4
+
+
+def allocate(ctx, size: tuple, prior: HitPool | None = None, budget: int | None = None,
+             slots: dict | None = None, per_item: float = CHUNKS_PER_TEXEL) -> HitPool:
+    """An empty pool for `size` = (w, h) traced texels (or (faces,) with slots=GATHER_SLOTS): `per_item` chunks an
+    item, or, after a `prior` record that kept every item (the last view of the scene), a quarter more than it
+    needed an item."""
+    slots = TRACE_SLOTS if slots is None else slots
+    items = int(np.prod(size))
     budget = BUDGET_BYTES if budget is None else budget
-    per_texel = float(CHUNKS_PER_TEXEL)
     if prior is not None and prior.recorded and prior.needed <= prior.capacity:
-        per_texel = min(per_texel, 1.25 * prior.needed / max(prior.size[0] * prior.size[1], 1) + 1.0)
-    # A storage block's size is capped too (128 MiB on llvmpipe): the points' buffer must fit in one.
+        per_item = min(per_item, 1.25 * prior.needed / max(prior.items, 1) + 1.0)
+    # A storage block's size is capped too (128 MiB on llvmpipe): each record buffer must fit in one.
     block = int(ctx.info.get("GL_MAX_SHADER_STORAGE_BLOCK_SIZE", 2 ** 27))
-    capacity = max(1, min(int(per_texel * texels), (budget - HEADER_BYTES * texels) // CHUNK_BYTES,
-                          block // (16 * HIT_CHUNK)))
-    slots = capacity * HIT_CHUNK
-    return TraceHits(ctx.buffer(reserve=HEADER_BYTES * texels), ctx.buffer(reserve=16 * slots),
-                     ctx.buffer(reserve=4 * slots), ctx.buffer(reserve=4 * capacity), tuple(size), capacity)
+    capacity = max(1, min(int(per_item * items), (budget - HEADER_BYTES * items) // chunk_bytes(slots),
+                          block // (max(slots.values()) * HIT_CHUNK)))
+    payload = {binding: ctx.buffer(reserve=width * HIT_CHUNK * capacity) for binding, width in slots.items()}
+    return HitPool(ctx.buffer(reserve=HEADER_BYTES * items), payload, ctx.buffer(reserve=4 * capacity),
+                   tuple(size), capacity)
 
 
-def bind(prog, hits: TraceHits, counter) -> None:
-    """The pool on storage buffers 4–7 and the chunk counter on 3 (vct/hits.glsl)."""
+def bind(prog, pool: HitPool, counter) -> None:
+    """The pool on storage buffers 4, 7 and its payload's, and the chunk counter on 3 (vct/hits.glsl)."""
     counter.bind_to_storage_buffer(3)
-    for binding, b in enumerate((hits.headers, hits.points, hits.tags, hits.next), start=4):
+    pool.headers.bind_to_storage_buffer(4)
+    pool.next.bind_to_storage_buffer(7)
+    for binding, b in pool.payload.items():
         b.bind_to_storage_buffer(binding)
-    set_uniform(prog, "u_chunk_capacity", hits.capacity)
+    set_uniform(prog, "u_chunk_capacity", pool.capacity)
 
 
 def new_counter(ctx):

@@ -74,15 +74,18 @@ class VoxelGeometry:
     """What the VCT passes derive from the geometry alone (the vct_geometry pass, keyed by the geometry, the
     emission, the grid and its levels), made by the first frame that needs each and kept across light, world and
     material colour edits, which would make them again the same: the faces' centroids (vct/inject.py), the layer
-    volumes (vct/mipmap.py) and the list of faces with coverage (vct/bounce.py). The passes' outputs that read them
-    do not own them."""
+    volumes (vct/mipmap.py), the list of faces with coverage and the steps their gathers take (vct/bounce.py). The
+    passes' outputs that read them do not own them."""
     centroids: list = None
     layers: object = None
     face_list: tuple = None  # (storage buffer, count)
+    gather_pool: object = None  # replay.HitPool of the gathers' steps, keyed by the cone settings (pool.key)
 
     def release(self):
         for t in (self.centroids or []) + [self.layers] * (self.layers is not None) + list(self.face_list or ())[:1]:
             t.release()
+        if self.gather_pool is not None:
+            self.gather_pool.release()
 
 
 @dataclass

@@ -75,7 +75,7 @@ def test_texels_the_pool_cannot_hold_are_traced_again(monkeypatch):
     try:
         engine.render(_room(), SETTINGS)
         _, _, pool = _traced(engine)
-        budget = replay.HEADER_BYTES * 40 * 30 + replay.CHUNK_BYTES * max(pool.needed // 20, 1)
+        budget = replay.HEADER_BYTES * 40 * 30 + replay.chunk_bytes(replay.TRACE_SLOTS) * max(pool.needed // 20, 1)
         monkeypatch.setattr(replay, "BUDGET_BYTES", budget)
         engine.shutdown()
         engine = Engine()

@@ -33,6 +33,9 @@ void main() {
     }
 }
 #else
+// MODE_RECORD_GATHER: the gathers, keeping each face's steps that absorbed light (vct/hits.glsl, header per list
+// entry); MODE_REPLAY_GATHER: the same gathers from those steps and the current volumes, bit for bit (the steps
+// depend on the opacities alone, which the bounces share), a face the record could not keep gathered again.
 layout(local_size_x = 64) in;
 layout(std430, binding = 5) readonly buffer FaceList { ivec4 faces[]; };
 uniform int u_face_first;   // this dispatch's first face (at most 65535 groups a dispatch)
@@ -40,6 +43,63 @@ uniform int u_face_count;   // faces in the list
 uniform sampler3D u_albedo;
 layout(rgba32f, binding = 0) uniform writeonly image3D u_face[6];
 VCT_STORE6(store_face, u_face)
+
+#if defined(MODE_REPLAY_GATHER)
+// The six volumes again, on u_volume's units (vct/bounce.py): through a switch of u_volume's own elements llvmpipe
+// got the dynamically indexed reads of the faces gathered again wrong (vct/trace.glsl says the same).
+uniform sampler3D u_replay0, u_replay1, u_replay2, u_replay3, u_replay4, u_replay5;
+vec4 volume_at(uint i, vec3 q, float lod) {
+    switch (i) {
+        case 0u: return textureLod(u_replay0, q, lod); case 1u: return textureLod(u_replay1, q, lod);
+        case 2u: return textureLod(u_replay2, q, lod); case 3u: return textureLod(u_replay3, q, lod);
+        case 4u: return textureLod(u_replay4, q, lod); default: return textureLod(u_replay5, q, lod);
+    }
+}
+
+// E at the face as gather_irradiance and trace_cone sum it, step by step in their order (cone_step's arithmetic).
+vec3 gather_replay(uvec4 header) {
+    vec3 e = vec3(0.0), radiance = vec3(0.0);
+    int cone = 0;
+    uint chunk = header.x;
+    for (uint h = 0u; h < header.y; ++h) {
+        GatherStep st = gather_steps[hit_at(h, chunk)];
+        uint tag = floatBitsToUint(st.alpha_t_tag.z);
+        for (; cone < int(tag & 31u); ++cone) {
+            e += u_cones[cone].w * radiance;
+            radiance = vec3(0.0);
+        }
+        uint sides = tag >> 5;
+        vec4 sx = volume_at(sides & 1u, st.uvw_lod.xyz, st.uvw_lod.w);
+        vec4 sy = volume_at(2u + ((sides >> 1) & 1u), st.uvw_lod.xyz, st.uvw_lod.w);
+        vec4 sz = volume_at(4u + ((sides >> 2) & 1u), st.uvw_lod.xyz, st.uvw_lod.w);
+        vec3 w = st.w_tau.xyz;
+        float tau = st.w_tau.w;
+        vec3 step_radiance = (w.x * sx.rgb + w.y * sy.rgb + w.z * sz.rgb) / tau;
+        float alpha = st.alpha_t_tag.x;
+        vec4 s = vec4(alpha * step_radiance, alpha);
+        radiance += st.alpha_t_tag.y * s.rgb;
+    }
+    for (; cone < u_cone_count; ++cone) {
+        e += u_cones[cone].w * radiance;
+        radiance = vec3(0.0);
+    }
+    return e;
+}
+#endif
+
+vec3 face_irradiance(int i, ivec3 v, int g) {
+    vec3 n = vec3(0.0);
+    n[g >> 1] = (g & 1) == 0 ? 1.0 : -1.0;
+#if defined(MODE_REPLAY_GATHER)
+    uvec4 header = hit_headers[i];
+    if (header.w == HIT_RECORDED) return gather_replay(header);
+#endif
+    vec3 e = gather_irradiance(centroid_face(g, v, 0).xyz, n, n, vec2(1.0, 0.0)).rgb;
+#if defined(MODE_RECORD_GATHER)
+    hit_headers[i] = uvec4(g_first, g_hits, 0u, g_overflow ? 0u : HIT_RECORDED);
+#endif
+    return e;
+}
 
 void main() {   // the faces without coverage keep the zeros their images start with (vct._texture3d)
     int i = u_face_first + int(gl_GlobalInvocationID.x);
@@ -49,12 +109,7 @@ void main() {   // the faces without coverage keep the zeros their images start 
     vec4 direct = direct_face(g, v, 0);
     vec3 albedo = texelFetch(u_albedo, v, 0).rgb;
     vec3 radiance = direct.rgb;
-    if (max(albedo.r, max(albedo.g, albedo.b)) > 0.0) {
-        vec3 n = vec3(0.0);
-        n[g >> 1] = (g & 1) == 0 ? 1.0 : -1.0;
-        vec4 e = gather_irradiance(centroid_face(g, v, 0).xyz, n, n, vec2(1.0, 0.0));
-        radiance += albedo * e.rgb / VCT_PI;
-    }
+    if (max(albedo.r, max(albedo.g, albedo.b)) > 0.0) radiance += albedo * face_irradiance(i, v, g) / VCT_PI;
     store_face(g, v, vec4(radiance, direct.a));
 }
 #endif

@@ -37,6 +37,12 @@ uniform sampler3D u_volume[1];
 
 const float VCT_PI = 3.14159265358979;
 
+#include "vct/hits.glsl"
+#if defined(MODE_RECORD_GATHER)
+vec3 g_weights;   // cone_step's axis weights and optical depth at its last sample, for record_step
+float g_tau;
+#endif
+
 // Premultiplied radiance and opacity of one step of k texels of the sampled level along unit direction d, from
 // volumes storing (τ·S, τ) (vct/mipmap.glsl): α' = 1 − e^(−k·τ), the usual step-length correction
 // α' = 1 − (1 − α)^k written in optical depth; radiance S = τ·S / τ, the τ-weighted mean of the filtered texels.
@@ -75,7 +81,11 @@ vec4 cone_step(vec3 uvw, float lod, vec3 d, float k, vec3 start) {
     w *= seen;
     tau = w.x * sx.a + w.y * sy.a + w.z * sz.a;
     if (tau <= 1e-9) return vec4(0.0);
-    vec3 radiance = (w.x * sx.rgb + w.y * sy.rgb + w.z * sz.rgb) / tau;
+    vec3 radiance = (w.x * sx.rgb + w.y * sy.rgb + w.z * sz.rgb) / tau;   // gather_replay (vct/bounce.glsl) too
+#if defined(MODE_RECORD_GATHER)
+    g_weights = w;
+    g_tau = tau;
+#endif
 #else
     vec4 s = textureLod(u_volume[0], uvw, lod);
     float tau = s.a;
@@ -92,6 +102,17 @@ struct ConeResult {
     bool exited;          // it left the grid (the world shows through the rest)
     float ao;             // transmittance at u_ao_distance, or the sky visibility when that is 0
 };
+
+#if defined(MODE_RECORD_GATHER)
+// A step of trace_cone that absorbed part of its cone (vct/hits.glsl GatherStep): all a replay needs but the radiance.
+void record_step(vec3 uvw, float lod, float alpha, float transmittance, vec3 d) {
+    uint i = hit_slot();
+    if (i == HIT_FULL) return;
+    uint volumes = uint(d.x < 0.0) | (uint(d.y < 0.0) << 1) | (uint(d.z < 0.0) << 2);   // 2a + 1 where d_a < 0
+    gather_steps[i] = GatherStep(vec4(uvw, lod), vec4(g_weights, g_tau),
+                                 vec4(alpha, transmittance, uintBitsToFloat(uint(g_cone) | (volumes << 5)), 0.0));
+}
+#endif
 
 // March one cone from surface point p (geometric normal n_geo, unit) along unit d with tan(half-angle) tan_half,
 // absorbing it volumetrically: the bounce gathers at voxel faces, the specular cone, and isotropic volumes use this;
@@ -133,6 +154,9 @@ ConeResult trace_cone(vec3 p, vec3 o, vec3 n_geo, vec3 d, float tan_half) {
         float cap = floor(log2(max(h / (1.5 * n1 * u_grid_cell), 1.0)));
         lod = min(min(lod, cap), u_max_lod);
         vec4 s = cone_step(g * inv_size, lod, d, u_step, g0);
+#if defined(MODE_RECORD_GATHER)
+        if (s.a > 0.0) record_step(g * inv_size, lod, s.a, r.transmittance, d);
+#endif
         r.radiance += r.transmittance * s.rgb;
         r.transmittance *= 1.0 - s.a;
         if (r.transmittance < MIN_TRANSMITTANCE) break;
@@ -201,7 +225,7 @@ vec4 gather_irradiance(vec3 p, vec3 n, vec3 n_geo, vec2 rot) {
         vec4 c = u_cones[k];
         vec2 xy = vec2(rot.x * c.x - rot.y * c.y, rot.y * c.x + rot.x * c.y);
         vec3 d = normalize(t1 * xy.x + t2 * xy.y + n * c.z);
-#if defined(MODE_RECORD)
+#if defined(MODE_RECORD) || defined(MODE_RECORD_GATHER)
         g_cone = k;
 #endif
 #if defined(MODE_CROSSING)

@@ -37,7 +37,6 @@
 // (VctSettings.subrays).
 #pragma once
 #if defined(MODE_CROSSING)
-#include "vct/hits.glsl"
 
 #if !defined(SUBRAYS)
 #define SUBRAYS 7                 // the axis and SUBRAYS − 1 rays around it (a define: loops of constant length

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The per-pixel sub-rays' hits, recorded once and replayed after a light or world edit (vct/replay.py).
+// The per-pixel sub-rays' hits, and the bounce gathers' steps, recorded once and replayed after a light, world or
+// material colour edit (vct/replay.py).
 //
 // Why it is exact: with the geometry, the camera and the trace settings fixed, everything a sub-ray does but the
 // radiance it reads depends on the volumes' optical depths and the layer volume alone (vct/crossing.glsl): where it
@@ -15,41 +16,69 @@
 // header = (first chunk, hits, the texel's AO bits, state): state 1 recorded, 2 background, 0 not recorded (the
 // pool ran out: a replay traces that texel again).
 #pragma once
+#if defined(MODE_RECORD) || defined(MODE_REPLAY) || defined(MODE_RECORD_GATHER) || defined(MODE_REPLAY_GATHER)
 
 #define HIT_CHUNK 16u
 #define HIT_RECORDED 1u
 #define HIT_BACKGROUND 2u
+#define HIT_FULL 0xffffffffu
 
 layout(std430, binding = 3) buffer HitCount { uint chunk_count; };
 layout(std430, binding = 4) buffer HitHeaders { uvec4 hit_headers[]; };
-layout(std430, binding = 5) buffer HitPoints { vec4 hit_points[]; };   // q (texture coordinates), α
-layout(std430, binding = 6) buffer HitTags { uint hit_tags[]; };
 layout(std430, binding = 7) buffer HitNext { uint hit_next[]; };        // per chunk
 uniform uint u_chunk_capacity;
 
-#if defined(MODE_RECORD)
+#if defined(MODE_RECORD) || defined(MODE_RECORD_GATHER)
 int g_cone = 0;            // the cone being traced (vct/common.glsl gather_irradiance sets it)
-int g_chunk = -1;          // this texel's current chunk
+int g_chunk = -1;          // this item's current chunk
 uint g_first = 0u, g_slot = 0u, g_hits = 0u;
 bool g_overflow = false;
 
-void record_hit(vec3 q, float lod, int volume, float alpha) {
-    if (g_overflow) return;
+// The slot for this item's next record, or HIT_FULL once the pool has run out (the item is then not kept).
+uint hit_slot() {
+    if (g_overflow) return HIT_FULL;
     if (g_chunk < 0 || g_slot == HIT_CHUNK) {
         uint c = atomicAdd(chunk_count, 1u);
         if (c >= u_chunk_capacity) {
             g_overflow = true;
-            return;
+            return HIT_FULL;
         }
         if (g_chunk < 0) g_first = c;
         else hit_next[g_chunk] = c;
         g_chunk = int(c);
         g_slot = 0u;
     }
-    uint i = uint(g_chunk) * HIT_CHUNK + g_slot;
+    g_hits += 1u;
+    return uint(g_chunk) * HIT_CHUNK + g_slot++;
+}
+#endif
+
+// The slot of an item's h-th record, walking its chunks (`chunk`: the chunk of record h − 1, then of record h).
+uint hit_at(uint h, inout uint chunk) {
+    if (h > 0u && h % HIT_CHUNK == 0u) chunk = hit_next[chunk];
+    return chunk * HIT_CHUNK + h % HIT_CHUNK;
+}
+
+#if defined(MODE_RECORD) || defined(MODE_REPLAY)
+// The per-pixel sub-rays' hits (vct/trace.glsl).
+layout(std430, binding = 5) buffer HitPoints { vec4 hit_points[]; };   // q (texture coordinates), α
+layout(std430, binding = 6) buffer HitTags { uint hit_tags[]; };       // cone | volume << 5 | level << 8
+#endif
+
+#if defined(MODE_RECORD)
+void record_hit(vec3 q, float lod, int volume, float alpha) {
+    uint i = hit_slot();
+    if (i == HIT_FULL) return;
     hit_points[i] = vec4(q, alpha);
     hit_tags[i] = uint(g_cone) | (uint(volume) << 5) | (uint(lod) << 8);
-    g_slot += 1u;
-    g_hits += 1u;
 }
+#endif
+
+#if defined(MODE_RECORD_GATHER) || defined(MODE_REPLAY_GATHER)
+// The bounce gathers' steps that absorbed part of their cone (vct/common.glsl trace_cone, cone_step): where the
+// step read (uvw, level), the axes' weights and optical depth it read there, its opacity α and the cone's
+// transmittance T before it, and (cone | the three volumes read << 5) as float bits.
+struct GatherStep { vec4 uvw_lod; vec4 w_tau; vec4 alpha_t_tag; };
+layout(std430, binding = 6) buffer GatherSteps { GatherStep gather_steps[]; };
+#endif
 #endif

@@ -48,8 +48,7 @@ vec3 replay(uvec4 header) {
     int cone = 0;
     uint chunk = header.x;
     for (uint h = 0u; h < header.y; ++h) {
-        if (h > 0u && h % HIT_CHUNK == 0u) chunk = hit_next[chunk];
-        uint i = chunk * HIT_CHUNK + h % HIT_CHUNK;
+        uint i = hit_at(h, chunk);
         vec4 point = hit_points[i];
         uint tag = hit_tags[i];
         for (; cone < int(tag & 31u); ++cone) {
