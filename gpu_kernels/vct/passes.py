@@ -61,6 +61,7 @@ def run(frame) -> MethodOutput:
     indirect, k_trace, extra = _per_pixel(frame, faces, bounced, (frame.keys["gbuffer"], k_bounce,
                                                                           s.key("trace")), (grid.key(), levels))
     info = {**trace.render_info(faces, bounced, s), "specular_pixels": glossy["traced"], **extra,
+            **replay.stats(shared.gather_pool, "gather_steps"),
             "skipped_work": bounce.skipped_work(bounced.bounce_stats or [], s) + specular.skipped_work(glossy, s)}
     key, out = (k_trace, k_spec), (indirect, glossy["glossy"])
     if np.any(scale != 1.0):

@@ -1,12 +1,16 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""vct_hits: the per-pixel sub-rays' hits, kept so that a light or world edit replays the per-pixel trace instead
-of tracing it again (vct/hits.glsl says why that gives the same image bit for bit).
+"""Pools of recorded cone samples, replayed instead of marching the cones again (vct/hits.glsl says why that gives
+the same result bit for bit): the per-pixel sub-rays' hits (vct_hits) and the bounce gathers' steps
+(volumes.VoxelGeometry.gather_pool).
 
 The first vct_trace over a G-buffer records, for every traced texel, each point where a sub-ray met a surface:
 where it read which volume at which level, and how much of the sub-ray that surface absorbed. Those depend on the
 geometry, the camera and the trace settings only (the pass's key), so while they hold, vct_trace reads each hit's
-radiance from the new volumes and sums — one texture read per hit instead of the march that found it. The pool is
-capped (BUDGET_BYTES): a texel whose hits no longer fit is marked, and a replay traces it again.
+radiance from the new volumes and sums — one texture read per hit instead of the march that found it. Likewise the
+first bounce gather records, per face, the steps of its cones that absorbed light (where, the axes' weights, the
+opacity and the cone's transmittance there), which the later bounces and every bounce after a light edit replay. A
+pool is capped (BUDGET_BYTES, and a storage block's size): an item whose records no longer fit is marked, and a
+replay marches it again.
 """
 from __future__ import annotations
 
@@ -106,9 +110,9 @@ def read_count(counter) -> int:
     return int(np.frombuffer(counter.read(), np.uint32)[0])
 
 
-def stats(hits: TraceHits | None) -> dict:
-    """render --json info: the pool's size and whether every texel's hits fit."""
-    if hits is None:
+def stats(pool: HitPool | None, name: str = "trace_hits") -> dict:
+    """render --json info: the pool's size and whether every item's records fit."""
+    if pool is None or not pool.recorded:
         return {}
-    return {"trace_hits": {"mib": round(hits.nbytes / 2 ** 20, 1), "chunks": min(hits.needed, hits.capacity),
-                           "all_kept": hits.needed <= hits.capacity}}
+    return {name: {"mib": round(pool.nbytes / 2 ** 20, 1), "chunks": min(pool.needed, pool.capacity),
+                   "all_kept": pool.needed <= pool.capacity}}
