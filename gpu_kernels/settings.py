@@ -21,7 +21,8 @@ METHODS = ("none", "lpv", "vct")
 # cell of each cascade, and ≈ 4 MB of VPL buffers at any size; the LPV's three voxelisations per axis
 # (lpv/receivers.py) are held one at a time). tests/stress/test_grids_bounces.py holds these to the peak of what a
 # render holds at once, so a volume added but not counted here fails a test. VCT's injection adds its cover
-# test's front-most images (vct/inject.front_bytes, sized by the grid's largest side).
+# test's front-most images (vct/inject.front_bytes, sized by the grid's largest side), and its recorded cone samples
+# (vct/replay.pool_bytes, sized by the surface area and the traced image).
 VCT_BYTES_PER_VOXEL, VCT_FIXED_BYTES = 940, 2 ** 20
 LPV_BYTES_PER_CELL, LPV_FIXED_BYTES = 2300, 8 * 2 ** 20
 # A triangle is degenerate when twice its area is below this fraction of its longest edge squared: its height is
@@ -69,10 +70,14 @@ def method_bytes(scene: Scene, settings: RenderSettings) -> int:
     """About how many bytes of GPU memory the method's volumes take (0 for "none")."""
     if settings.method == "vct":
         from .vct.inject import front_bytes
+        from .vct.replay import pool_bytes
         from .vct.volumes import vct_grid
+        from .voxel.voxelize import scene_area
 
-        grid = vct_grid(scene, settings.vct)
-        return grid.voxel_count * VCT_BYTES_PER_VOXEL + front_bytes(grid) + VCT_FIXED_BYTES
+        grid, scale = vct_grid(scene, settings.vct), settings.vct.indirect_scale
+        traced = (-(-settings.width // scale), -(-settings.height // scale))
+        return (grid.voxel_count * VCT_BYTES_PER_VOXEL + front_bytes(grid) + VCT_FIXED_BYTES
+                + pool_bytes(scene_area(scene), grid.cell, traced))
     if settings.method == "lpv":
         from .lpv.state import cascade_grids
 
