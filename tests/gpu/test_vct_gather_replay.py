@@ -17,12 +17,12 @@ from support.synthetic import box_quads, quad_scene
 SETTINGS = RenderSettings("vct", 40, 30, vct=VctSettings(resolution=32))
 
 
-def _room(lamp=(-0.3, 0.2, 1.5)):
+def _room(lamp=(-0.3, 0.2, 1.5), block=(0.8, 0.2, 0.1)):
     matrix = np.eye(4)
     matrix[:3, 3] = lamp
     quads = box_quads((-1, -1, 0), (1, 1, 2), 0, skip=((2, "hi"),))
     quads += box_quads((-0.3, -0.3, 0.0), (0.3, 0.3, 0.7), 1, inward=False)
-    return quad_scene(quads, [Material("white", (0.7, 0.7, 0.7)), Material("red", (0.8, 0.2, 0.1))],
+    return quad_scene(quads, [Material("white", (0.7, 0.7, 0.7)), Material("block", block)],
                       [Light("bulb", "POINT", (1, 1, 1), 60.0, matrix)], (0.0, -0.9, 1.5), (0.0, 0.5, 0.3))
 
 
@@ -55,5 +55,21 @@ def test_replayed_gathers_are_the_gathers(monkeypatch, per_face):
         for name in ("Diffuse Indirect", "Combined"):
             assert np.array_equal(replayed.passes[name], plain.passes[name]), name
         assert [b["flux"] for b in replayed.info["bounces"]] == [b["flux"] for b in plain.info["bounces"]]
+    finally:
+        engine.shutdown()
+
+
+def test_a_black_surface_made_bright_is_gathered_anew(monkeypatch):
+    """A face without albedo is not gathered, so the first gather records nothing for the black block's faces; once
+    its colour is bright, a replay gathers them (their records marked absent), as plain gathers do."""
+    engine = Engine()
+    try:
+        engine.render(_room(block=(0.0, 0.0, 0.0)), SETTINGS)
+        edited = _room(block=(0.8, 0.2, 0.1))
+        replayed = engine.render(edited, SETTINGS)
+        assert "vct_geometry" in replayed.skipped
+        plain = _gathered_plainly(engine, edited, monkeypatch)
+        for name in ("Diffuse Indirect", "Combined"):
+            assert np.array_equal(replayed.passes[name], plain.passes[name]), name
     finally:
         engine.shutdown()
