@@ -96,8 +96,6 @@ def gather_program(programs, source: ConeVolumes, direct_faces: Faces, vox, s: V
         defines["MODE_REPLAY_GATHER" if pool.recorded else "MODE_RECORD_GATHER"] = None
     prog = programs.compute("vct/bounce.glsl", defines or None)
     unit = bind_volumes(prog, source, 0)
-    for i in range(len(source.textures)):  # MODE_REPLAY_GATHER reads them under other names too
-        set_uniform(prog, f"u_replay{i}", i)
     unit = bind_samplers(prog, "u_direct", direct_faces.textures, unit)
     unit = bind_samplers(prog, "u_centroid", direct_faces.centroids, unit)
     bind_samplers(prog, "u_albedo", [vox.albedo], unit)
@@ -124,19 +122,11 @@ def gather_listed(ctx, prog, listed, count: int, pool: replay.HitPool | None = N
     into it (and marked recorded) or replayed from it."""
     listed.bind_to_storage_buffer(5)
     set_uniform(prog, "u_face_count", count)
-    counter = replay.new_counter(ctx) if pool is not None else None
-    try:
-        if pool is not None:
-            replay.bind(prog, pool, counter)
+    with replay.pooled(ctx, prog, pool):
         for first in range(0, count, FACES_PER_DISPATCH):
             set_uniform(prog, "u_face_first", first)
             dispatch(prog, (min(FACES_PER_DISPATCH, count - first),), 64)
         ctx.memory_barrier()
-        if pool is not None and not pool.recorded:
-            pool.recorded, pool.needed = True, replay.read_count(counter)
-    finally:
-        if counter is not None:
-            counter.release()
 
 
 def _total(stat: dict) -> float:

@@ -14,6 +14,7 @@ replay marches it again.
 """
 from __future__ import annotations
 
+from contextlib import contextmanager
 from dataclasses import dataclass
 
 import numpy as np
@@ -65,9 +66,6 @@ class HitPool:
             b.release()
 
 
-TraceHits = HitPool  # the per-pixel trace's pool (vct_hits)
-
-
 def chunk_bytes(slots: dict) -> int:
     """A chunk's bytes: its slots' records and the link to the next chunk."""
     return HIT_CHUNK * sum(slots.values()) + 4
@@ -108,22 +106,27 @@ def pool_bytes(area: float, cell: float, traced: tuple) -> int:
     return int(min(hits, BUDGET_BYTES) + min(steps, BUDGET_BYTES))
 
 
-def bind(prog, pool: HitPool, counter) -> None:
-    """The pool on storage buffers 4, 7 and its payload's, and the chunk counter on 3 (vct/hits.glsl)."""
-    counter.bind_to_storage_buffer(3)
-    pool.headers.bind_to_storage_buffer(4)
-    pool.next.bind_to_storage_buffer(7)
-    for binding, b in pool.payload.items():
-        b.bind_to_storage_buffer(binding)
-    set_uniform(prog, "u_chunk_capacity", pool.capacity)
-
-
-def new_counter(ctx):
-    return ctx.buffer(np.zeros(4, np.uint32).tobytes())
-
-
-def read_count(counter) -> int:
-    return int(np.frombuffer(counter.read(), np.uint32)[0])
+@contextmanager
+def pooled(ctx, prog, pool: HitPool | None):
+    """Around the dispatches of `prog` that record into or replay from `pool` (none: nothing): the pool on storage
+    buffers 4, 7 and its payload's, a chunk counter on 3 (vct/hits.glsl); a pool not yet recorded is marked
+    recorded afterwards, with the chunks the dispatches asked for."""
+    if pool is None:
+        yield
+        return
+    counter = ctx.buffer(np.zeros(4, np.uint32).tobytes())
+    try:
+        counter.bind_to_storage_buffer(3)
+        pool.headers.bind_to_storage_buffer(4)
+        pool.next.bind_to_storage_buffer(7)
+        for binding, b in pool.payload.items():
+            b.bind_to_storage_buffer(binding)
+        set_uniform(prog, "u_chunk_capacity", pool.capacity)
+        yield
+        if not pool.recorded:
+            pool.recorded, pool.needed = True, int(np.frombuffer(counter.read(), np.uint32)[0])
+    finally:
+        counter.release()
 
 
 def stats(pool: HitPool | None, name: str = "trace_hits") -> dict:

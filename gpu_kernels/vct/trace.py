@@ -38,7 +38,7 @@ def traced_size(gbuffer, s: VctSettings) -> tuple:
 
 
 def trace(ctx, programs, gbuffer, faces: Faces, volumes: ConeVolumes, s: VctSettings,
-          rotation_deg: float | None = None, hits: replay.TraceHits | None = None) -> dict:
+          rotation_deg: float | None = None, hits: replay.HitPool | None = None) -> dict:
     """Diffuse cones per G-buffer pixel, or per indirect_scale² block (vct/trace.glsl): {'indirect': RGBA32F
     texture of ceil(W/s) × ceil(H/s), rgb = Diffuse Indirect (irradiance/π), a = voxel AO; 'scale': s}. The cone
     set is turned by `rotation_deg` about the normal (default s.cone_rotation). `hits` (anisotropic volumes only,
@@ -51,17 +51,9 @@ def trace(ctx, programs, gbuffer, faces: Faces, volumes: ConeVolumes, s: VctSett
     set_uniform(prog, "u_image_size", (w, h))
     set_uniform(prog, "u_scale", scale)
     out.bind_to_image(0, read=False, write=True)
-    counter = replay.new_counter(ctx) if hits is not None else None
-    try:
-        if hits is not None:
-            replay.bind(prog, hits, counter)
+    with replay.pooled(ctx, prog, hits):
         dispatch(prog, (w, h), local=8)
         ctx.memory_barrier()
-        if mode == "record":
-            hits.recorded, hits.needed = True, replay.read_count(counter)
-    finally:
-        if counter is not None:
-            counter.release()
     return {"indirect": out, "scale": scale, "replayed": mode == "replay"}
 
 
@@ -86,8 +78,6 @@ def trace_program(programs, gbuffer, faces, volumes, s, rotation_deg, fixup: boo
         defines["MODE_RECORD" if hits == "record" else "MODE_REPLAY"] = None
     prog = programs.compute("vct/trace.glsl", defines or None)
     unit = bind_volumes(prog, volumes, 0)
-    for i in range(len(volumes.textures)):  # MODE_REPLAY reads them under other names (vct/trace.glsl)
-        set_uniform(prog, f"u_replay{i}", i)
     unit = bind_samplers(prog, "u_centroid", faces.centroids, unit)
     for name in ("position", "normal", "geo_normal"):
         unit = bind_samplers(prog, f"u_{name}", [gbuffer.textures[name]], unit)

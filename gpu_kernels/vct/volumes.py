@@ -7,7 +7,7 @@ import math
 from dataclasses import dataclass
 
 from ..common.grid import Grid
-from ..gl.bind import bind_samplers
+from ..gl.bind import bind_samplers, set_uniform
 from ..scene import Scene
 from .settings import VctSettings
 
@@ -116,9 +116,11 @@ class ConeVolumes:
 
 
 def bind_volumes(prog, volumes: ConeVolumes, first: int) -> int:
-    """Bind the cone volumes (sampler array u_volume) and, anisotropic, their layer volume (u_layers) from unit
-    `first`; returns the next free unit."""
+    """Bind the cone volumes (sampler array u_volume, and u_replay0… on the same units) and, anisotropic, their
+    layer volume (u_layers) from unit `first`; returns the next free unit."""
     unit = bind_samplers(prog, "u_volume", volumes.textures, first)
+    for i in range(len(volumes.textures)):  # the replays read them under other names too (vct/hits.glsl)
+        set_uniform(prog, f"u_replay{i}", first + i)
     return bind_samplers(prog, "u_layers", [volumes.layers] if volumes.layers is not None else [], unit)
 
 

@@ -45,17 +45,6 @@ layout(rgba32f, binding = 0) uniform writeonly image3D u_face[6];
 VCT_STORE6(store_face, u_face)
 
 #if defined(MODE_REPLAY_GATHER)
-// The six volumes again, on u_volume's units (vct/bounce.py): through a switch of u_volume's own elements llvmpipe
-// got the dynamically indexed reads of the faces gathered again wrong (vct/trace.glsl says the same).
-uniform sampler3D u_replay0, u_replay1, u_replay2, u_replay3, u_replay4, u_replay5;
-vec4 volume_at(uint i, vec3 q, float lod) {
-    switch (i) {
-        case 0u: return textureLod(u_replay0, q, lod); case 1u: return textureLod(u_replay1, q, lod);
-        case 2u: return textureLod(u_replay2, q, lod); case 3u: return textureLod(u_replay3, q, lod);
-        case 4u: return textureLod(u_replay4, q, lod); default: return textureLod(u_replay5, q, lod);
-    }
-}
-
 // E at the face as gather_irradiance and trace_cone sum it, step by step in their order (cone_step's arithmetic).
 vec3 gather_replay(uvec4 header) {
     vec3 e = vec3(0.0), radiance = vec3(0.0);
@@ -64,10 +53,7 @@ vec3 gather_replay(uvec4 header) {
     for (uint h = 0u; h < header.y; ++h) {
         GatherStep st = gather_steps[hit_at(h, chunk)];
         uint tag = floatBitsToUint(st.alpha_t_tag.z);
-        for (; cone < int(tag & 31u); ++cone) {
-            e += u_cones[cone].w * radiance;
-            radiance = vec3(0.0);
-        }
+        end_cones(e, radiance, cone, int(tag & 31u));
         uint sides = tag >> 5;
         vec4 sx = volume_at(sides & 1u, st.uvw_lod.xyz, st.uvw_lod.w);
         vec4 sy = volume_at(2u + ((sides >> 1) & 1u), st.uvw_lod.xyz, st.uvw_lod.w);
@@ -79,10 +65,7 @@ vec3 gather_replay(uvec4 header) {
         vec4 s = vec4(alpha * step_radiance, alpha);
         radiance += st.alpha_t_tag.y * s.rgb;
     }
-    for (; cone < u_cone_count; ++cone) {
-        e += u_cones[cone].w * radiance;
-        radiance = vec3(0.0);
-    }
+    end_cones(e, radiance, cone, u_cone_count);
     return e;
 }
 #endif

@@ -74,6 +74,29 @@ void record_hit(vec3 q, float lod, int volume, float alpha) {
 }
 #endif
 
+#if defined(MODE_REPLAY) || defined(MODE_REPLAY_GATHER)
+// The six volumes again, on u_volume's units (vct/volumes.bind_volumes), read through a switch: the volume differs
+// between lanes (vct/arrays.glsl). Through a switch of u_volume's own elements, llvmpipe (Mesa 22) got the
+// dynamically indexed u_volume reads of the items a replay marches again wrong.
+uniform sampler3D u_replay0, u_replay1, u_replay2, u_replay3, u_replay4, u_replay5;
+vec4 volume_at(uint i, vec3 q, float lod) {
+    switch (i) {
+        case 0u: return textureLod(u_replay0, q, lod); case 1u: return textureLod(u_replay1, q, lod);
+        case 2u: return textureLod(u_replay2, q, lod); case 3u: return textureLod(u_replay3, q, lod);
+        case 4u: return textureLod(u_replay4, q, lod); default: return textureLod(u_replay5, q, lod);
+    }
+}
+
+// A replay's cones up to (not including) `until` are done: each adds its weight times its radiance to e, in cone
+// order, as gather_irradiance does (vct/common.glsl).
+void end_cones(inout vec3 e, inout vec3 radiance, inout int cone, int until) {
+    for (; cone < until; ++cone) {
+        e += u_cones[cone].w * radiance;
+        radiance = vec3(0.0);
+    }
+}
+#endif
+
 #if defined(MODE_RECORD_GATHER) || defined(MODE_REPLAY_GATHER)
 // The bounce gathers' steps that absorbed part of their cone (vct/common.glsl trace_cone, cone_step): where the
 // step read (uvw, level), the axes' weights and optical depth it read there, its opacity α and the cone's

@@ -29,18 +29,6 @@ layout(rgba32f, binding = 0) uniform writeonly image2D u_indirect;
 #endif
 
 #if defined(MODE_REPLAY)
-// The six volumes again, on the units of u_volume (vct/trace.py): read through a switch (the volume differs between
-// lanes, vct/arrays.glsl) of u_volume's own elements, llvmpipe (Mesa 22) got the sub-rays' u_volume[2 * a] wrong in
-// the texels this program traces again.
-uniform sampler3D u_replay0, u_replay1, u_replay2, u_replay3, u_replay4, u_replay5;
-vec4 volume_at(uint i, vec3 q, float lod) {
-    switch (i) {
-        case 0u: return textureLod(u_replay0, q, lod); case 1u: return textureLod(u_replay1, q, lod);
-        case 2u: return textureLod(u_replay2, q, lod); case 3u: return textureLod(u_replay3, q, lod);
-        case 4u: return textureLod(u_replay4, q, lod); default: return textureLod(u_replay5, q, lod);
-    }
-}
-
 // The texel's Diffuse Indirect as trace_cone_crossing and gather_irradiance sum it, term by term in their order.
 vec3 replay(uvec4 header) {
     const float inv_ns = 1.0 / float(SUBRAYS);
@@ -51,18 +39,12 @@ vec3 replay(uvec4 header) {
         uint i = hit_at(h, chunk);
         vec4 point = hit_points[i];
         uint tag = hit_tags[i];
-        for (; cone < int(tag & 31u); ++cone) {
-            e += u_cones[cone].w * radiance;
-            radiance = vec3(0.0);
-        }
+        end_cones(e, radiance, cone, int(tag & 31u));
         vec4 s = volume_at((tag >> 5) & 7u, point.xyz, float(tag >> 8));
         float alpha = point.w;
         radiance += inv_ns * alpha * s.rgb / s.a;
     }
-    for (; cone < u_cone_count; ++cone) {
-        e += u_cones[cone].w * radiance;
-        radiance = vec3(0.0);
-    }
+    end_cones(e, radiance, cone, u_cone_count);
     return e;
 }
 #endif
