@@ -27,6 +27,9 @@ class GBuffer:
     eye: tuple = (0.0, 0.0, 0.0)
     forward: tuple = (0.0, 0.0, -1.0)
     ortho: bool = False
+    # World → clip (float64 4 × 4, OpenGL) where the G-buffer is a camera's view; None for the viewport's
+    # surface atlas. vct/reuse.py projects the last view's samples with it.
+    view_projection: object = None
 
     def release(self):
         self.fbo.release()
@@ -63,7 +66,7 @@ def render_gbuffer(ctx, programs, scene: Scene, geometry: GeometryBuffers, textu
     set_uniform(prog, "u_camera_ortho", camera.type == "ORTHO")
     draw_by_material(prog, scene, geometry, textures)
     return GBuffer(targets, depth, fbo, (width, height), tuple(float(c) for c in cam_world[:3, 3]),
-                   tuple(float(c) for c in forward), camera.type == "ORTHO")
+                   tuple(float(c) for c in forward), camera.type == "ORTHO", proj @ view)
 
 
 def box_pixels(scene: Scene, width: int, height: int, box: np.ndarray) -> tuple:

@@ -72,14 +72,16 @@ def dispatch(prog, size, local=VOLUME_GROUP) -> None:
     prog.run(*(g + (1,) * (3 - len(g))))
 
 
-def dispatch_counted(ctx, prog, size, local: int = 8) -> int:
-    """dispatch() a program that counts what it did in an atomic uint on storage buffer 3; returns the count."""
+def dispatch_counted(ctx, prog, size, local: int = 8, counts: int = 1):
+    """dispatch() a program that counts what it did in atomic uints on storage buffer 3; returns the count (or the
+    first `counts` of them, a tuple, where it keeps more than one)."""
     counter = ctx.buffer(np.zeros(4, np.uint32).tobytes())
     try:
         counter.bind_to_storage_buffer(3)
         dispatch(prog, size, local)
         ctx.memory_barrier()
-        return int(np.frombuffer(counter.read(), np.uint32)[0])
+        values = tuple(int(v) for v in np.frombuffer(counter.read(), np.uint32)[:counts])
+        return values[0] if counts == 1 else values
     finally:
         counter.release()
 

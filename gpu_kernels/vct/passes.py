@@ -12,7 +12,9 @@
     vct_hits        ← geometry, camera, emission, grid, trace settings: the per-pixel trace's hits
                       (vct/replay.py), filled by the first vct_trace and replayed by the next ones (a light,
                       world or material colour edit)
-    vct_trace       ← gbuffer, bounced volumes, trace settings, accumulation frame
+    vct_trace       ← gbuffer, bounced volumes, trace settings, accumulation frame; after a camera move, the
+                      last view's vct_trace, whose gathers it reuses where they lie on its samples' surfaces
+                      (vct/reuse.py)
     vct_upsample    ← vct_trace (indirect_scale > 1)
     vct_accumulate  ← the upsampled trace (temporal_frames > 1)
     vct_scale       ← the results, the largest light colour (scaled back to the lights' own colours)
@@ -22,7 +24,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..common.method import MethodOutput
-from . import bounce, colours, inject, mipmap, replay, specular, temporal, trace, upsample
+from . import bounce, colours, inject, mipmap, replay, reuse, specular, temporal, trace, upsample
 from .volumes import VoxelGeometry, mip_levels, vct_grid, voxelize_scene
 
 # Outputs kept per pass (gl/pass_cache.py): the voxels, what their geometry decides and the per-pixel hits of two
@@ -84,16 +86,16 @@ def _per_pixel(frame, faces, bounced, base, grid):
     index = temporal.frame_index(prior.value if prior and accumulating else None, base, s.temporal_frames)
     rotation = temporal.jitter_deg(s, index) if accumulating else s.cone_rotation
     k_trace = (base, index)
-    hits = None
-    if s.anisotropic and not accumulating:
+    hits, last = None, reuse.last_view(cache, k_trace, gbuffer, s)
+    if s.anisotropic and not accumulating and last is None:
         size = trace.traced_size(gbuffer, s)
         k_hits = tuple(frame.keys[k] for k in ("geometry", "camera", "emission")) + (size, grid, s.key("trace"))
         # sized from the last record with the same cones (the viewport's draft stage traces fewer)
         prior = next((v for k, v in cache.kept("vct_hits") if k[-1] == k_hits[-1]), None)
         hits = cache.run("vct_hits", k_hits, lambda: replay.allocate(ctx, size, prior))
-    traced = cache.run("vct_trace", k_trace, lambda: trace.trace(ctx, programs, gbuffer, faces, bounced, s,
-                                                                 rotation, hits))
-    info = replay.stats(hits)
+    traced = cache.run("vct_trace", k_trace, lambda: reuse.trace_view(ctx, programs, gbuffer, faces, bounced, s,
+                                                                      rotation, hits, last))
+    info = {**replay.stats(hits), "reused_texels": traced.get("reused", 0)}
     indirect = traced["indirect"]
     if s.indirect_scale > 1:
         up = cache.run("vct_upsample", k_trace, lambda: upsample.upsample(

@@ -71,6 +71,12 @@ class VctSettings:
     # angle and averages into a history, until this many frames are in; any change to the trace's inputs restarts
     # it. 0 or 1 = off.
     temporal_frames: int = 0
+    # After a camera move, a sample takes the last view's gather where that was traced on its surface within this
+    # many of its texels (vct/reuse.py); the others are traced. 0 = trace every sample again. Default half a texel's
+    # diagonal, the farthest any point lies from the nearest texel centre: a surface seen again finds a last sample
+    # almost everywhere. Measured (benchmarks/results/vct_llvmpipe.md): 0.5 retraced 2-3 times as many samples
+    # for the same error against Cycles.
+    reuse_reach: float = 0.71
     cone_rotation: float = 0.0  # degrees the diffuse cone set is turned about the normal (the jitter adds to it)
     # Six directional volumes (Crassin) rather than one isotropic volume. Default on, measured: isotropic voxels
     # show a wall's lit side from both sides, and with 4 bounces Cornell / courtyard Diffuse Indirect came out
@@ -100,6 +106,7 @@ class VctSettings:
             (self.ao_distance >= 0 and math.isfinite(self.ao_distance), "ao_distance must be ≥ 0"),
             (self.indirect_scale in (1, 2, 4), f"indirect_scale {self.indirect_scale} must be 1, 2 or 4"),
             (0 <= self.temporal_frames <= 256, f"temporal_frames {self.temporal_frames} out of range 0..256"),
+            (0.0 <= self.reuse_reach <= 2.0, f"reuse_reach {self.reuse_reach} out of range 0..2 texels"),
             (math.isfinite(self.cone_rotation), "cone_rotation must be finite"),
         ]
         for ok, message in checks:
@@ -111,7 +118,7 @@ class VctSettings:
         'specular' (resolution and anisotropy key the earlier passes)."""
         extra = {"bounce": CONE_FIELDS + ("bounce_cones", "bounces", "gathered_bounces", "epsilon"),
                  "trace": CONE_FIELDS + ("subrays", "ao_distance", "indirect_scale", "cone_rotation",
-                                         "temporal_frames"),
+                                         "temporal_frames", "reuse_reach"),
                  "specular": ("max_distance", "step_multiplier", "start_offset", "specular_cone",
                               "roughness_cutoff")}[kind]
         d = asdict(self)

@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """vct_trace: the diffuse cones per G-buffer pixel (or per indirect_scale² block) → Diffuse Indirect and voxel
-AO (Crassin et al. 2011, cone tracing of the filtered volumes), the fix-up trace the upsampling asks for, the cone
-uniforms every cone pass shares, and read-backs for tests and statistics."""
+AO (Crassin et al. 2011, cone tracing of the filtered volumes), the trace of the texels the upsampling and the
+reuse after a camera move mark, the cone uniforms every cone pass shares, and read-backs for tests and statistics."""
 from __future__ import annotations
 
 import math
@@ -38,16 +38,17 @@ def traced_size(gbuffer, s: VctSettings) -> tuple:
 
 
 def trace(ctx, programs, gbuffer, faces: Faces, volumes: ConeVolumes, s: VctSettings,
-          rotation_deg: float | None = None, hits: replay.HitPool | None = None) -> dict:
+          rotation_deg: float | None = None, hits: replay.HitPool | None = None, out=None) -> dict:
     """Diffuse cones per G-buffer pixel, or per indirect_scale² block (vct/trace.glsl): {'indirect': RGBA32F
-    texture of ceil(W/s) × ceil(H/s), rgb = Diffuse Indirect (irradiance/π), a = voxel AO; 'scale': s}. The cone
-    set is turned by `rotation_deg` about the normal (default s.cone_rotation). `hits` (anisotropic volumes only,
-    vct/replay.py): an empty pool is filled with the trace's hits, a filled one replayed (the same image)."""
+    texture of ceil(W/s) × ceil(H/s) (`out` where given), rgb = Diffuse Indirect (irradiance/π), a = voxel AO;
+    'scale': s}. The cone set is turned by `rotation_deg` about the normal (default s.cone_rotation). `hits`
+    (anisotropic volumes only, vct/replay.py): an empty pool is filled with the trace's hits, a filled one replayed
+    (the same image)."""
     scale = int(s.indirect_scale)
     w, h = traced_size(gbuffer, s)
-    out = ctx.texture((w, h), 4, dtype="f4")
+    out = ctx.texture((w, h), 4, dtype="f4") if out is None else out
     mode = None if hits is None else ("replay" if hits.recorded else "record")
-    prog = trace_program(programs, gbuffer, faces, volumes, s, rotation_deg, fixup=False, hits=mode)
+    prog = trace_program(programs, gbuffer, faces, volumes, s, rotation_deg, marked=False, hits=mode)
     set_uniform(prog, "u_image_size", (w, h))
     set_uniform(prog, "u_scale", scale)
     out.bind_to_image(0, read=False, write=True)
@@ -57,23 +58,24 @@ def trace(ctx, programs, gbuffer, faces: Faces, volumes: ConeVolumes, s: VctSett
     return {"indirect": out, "scale": scale, "replayed": mode == "replay"}
 
 
-def fixup(ctx, programs, gbuffer, faces: Faces, volumes: ConeVolumes, s: VctSettings, texture,
-          rotation_deg: float | None = None) -> None:
-    """Trace, in place and at full resolution, the pixels of `texture` that vct/upsample.glsl marked (a < 0)."""
-    w, h = gbuffer.size
-    prog = trace_program(programs, gbuffer, faces, volumes, s, rotation_deg, fixup=True)
-    set_uniform(prog, "u_image_size", (w, h))
-    set_uniform(prog, "u_scale", 1)
+def trace_marked(ctx, programs, gbuffer, faces: Faces, volumes: ConeVolumes, s: VctSettings, texture, scale: int,
+                 rotation_deg: float | None = None) -> None:
+    """Trace, in place, the texels of `texture` marked a < 0 (vct/trace.glsl MODE_MARKED): at full resolution
+    (`scale` 1) the pixels vct/upsample.glsl marked, at indirect_scale the texels vct/reuse.glsl found no gather
+    of the last view for."""
+    prog = trace_program(programs, gbuffer, faces, volumes, s, rotation_deg, marked=True)
+    set_uniform(prog, "u_image_size", tuple(texture.size))
+    set_uniform(prog, "u_scale", int(scale))
     texture.bind_to_image(0, read=True, write=True)
-    dispatch(prog, (w, h), local=8)
+    dispatch(prog, tuple(texture.size), local=8)
     ctx.memory_barrier()
 
 
-def trace_program(programs, gbuffer, faces, volumes, s, rotation_deg, fixup: bool, hits: str | None = None):
+def trace_program(programs, gbuffer, faces, volumes, s, rotation_deg, marked: bool, hits: str | None = None):
     # Anisotropic volumes carry the layer volume the sub-rays need to find where surfaces lie (vct/crossing.glsl).
     defines = {"MODE_ANISO": None, "MODE_CROSSING": None, "SUBRAYS": int(s.subrays)} if volumes.anisotropic else {}
-    if fixup:
-        defines["MODE_FIXUP"] = None
+    if marked:
+        defines["MODE_MARKED"] = None
     if hits is not None:  # vct/hits.glsl
         defines["MODE_RECORD" if hits == "record" else "MODE_REPLAY"] = None
     prog = programs.compute("vct/trace.glsl", defines or None)

@@ -4,14 +4,14 @@ lighting at a reduced resolution plus discontinuity-aware upsampling).
 
 vct/trace.glsl gathers at every s-th G-buffer pixel (VctSettings.indirect_scale = s: s² fewer cone sets);
 vct/upsample.glsl blends the 2×2 nearest gathers with bilinear × tangent-plane-distance × normal weights, and pixels
-whose surface none of them lies on are traced again at full resolution (vct/trace.glsl MODE_FIXUP), so light never
+whose surface none of them lies on are traced again at full resolution (vct/trace.glsl MODE_MARKED), so light never
 crosses a depth or normal discontinuity. The trade (time against Diffuse Indirect error vs Cycles) is measured in
 benchmarks/vct_bench.py.
 """
 from __future__ import annotations
 
 from ..gl.bind import bind_samplers, dispatch_counted, set_uniforms
-from .trace import fixup
+from .trace import trace_marked
 
 SIGMA_VOXELS = 0.5  # plane-distance scale in voxels (vct/upsample.glsl says why)
 
@@ -22,7 +22,7 @@ def upsample(ctx, programs, gbuffer, low: dict, faces, volumes, s, rotation_deg=
     out, marked = joint_bilateral(ctx, programs, gbuffer, low["indirect"], int(low["scale"]),
                                   SIGMA_VOXELS * volumes.grid.cell)
     if marked:
-        fixup(ctx, programs, gbuffer, faces, volumes, s, out, rotation_deg)
+        trace_marked(ctx, programs, gbuffer, faces, volumes, s, out, 1, rotation_deg)
     return {"indirect": out, "fixup": marked}
 
 

@@ -93,11 +93,13 @@ def test_texels_the_pool_cannot_hold_are_traced_again(monkeypatch):
 
 @pytest.mark.parametrize("edit", [dict(block=0.2), dict(eye=(0.1, -0.9, 1.4))], ids=["object move", "camera"])
 def test_moving_geometry_or_the_camera_records_anew(edit):
+    """(A camera move with the last view's gathers reused records nothing: tests/gpu/test_vct_reuse.py.)"""
+    settings = RenderSettings("vct", 40, 30, vct=VctSettings(resolution=32, reuse_reach=0.0))
     engine = Engine()
     try:
-        engine.render(_room(), SETTINGS)
+        engine.render(_room(), settings)
         _, _, before = _traced(engine)
-        result = engine.render(_room(**edit), SETTINGS)
+        result = engine.render(_room(**edit), settings)
         _, replayed, after = _traced(engine)
         assert not replayed and after is not before and after.recorded
         assert "vct_hits" not in result.skipped

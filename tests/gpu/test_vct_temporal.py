@@ -97,7 +97,9 @@ def test_any_change_restarts_the_history_without_a_ghost(engine):
     for changed, s in ((turned, settings), (moved, settings), (moved, _settings(temporal_frames=N, ao_distance=0.5))):
         r = engine.render(changed, s)
         assert r.info["temporal"]["frames"] == 1
-        plain = fresh.render(changed, dataclasses.replace(s, vct=dataclasses.replace(s.vct, temporal_frames=0)))
+        # (a full trace: without reuse_reach 0 the camera move would take the turned view's gathers, vct/reuse.py)
+        plain = fresh.render(changed, dataclasses.replace(s, vct=dataclasses.replace(s.vct, temporal_frames=0,
+                                                                                      reuse_reach=0.0)))
         for name in ("Diffuse Indirect", "AO", "Combined"):
             np.testing.assert_allclose(r.passes[name], plain.passes[name], rtol=1e-6, atol=1e-7)
         r2 = engine.render(changed, s)  # and it accumulates from there

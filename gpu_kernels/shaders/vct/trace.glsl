@@ -8,8 +8,9 @@
 // ceil(H/s) and output texel i gathers at full-resolution pixel i·s + s/2 (clamped to the image), so every traced
 // sample lies exactly on a G-buffer pixel and vct/upsample.glsl can compare its position and normal with its
 // neighbours'.
-// MODE_FIXUP: full resolution, in place: only pixels vct/upsample.glsl marked (a < 0: no low-resolution sample lies
-// on their surface) are traced; the rest keep their upsampled value.
+// MODE_MARKED: in place, only the texels marked a < 0 are traced; the rest keep their value. At full resolution
+// (u_scale 1) the pixels vct/upsample.glsl marked (no low-resolution sample lies on their surface); at the reduced
+// one the texels vct/reuse.glsl found no gather of the last view for.
 // MODE_RECORD: the trace, keeping every texel's sub-ray hits (vct/hits.glsl); MODE_REPLAY: the same image from
 // those hits and the current volumes, a texel the record could not keep traced again.
 #include "vct/common.glsl"
@@ -22,7 +23,7 @@ uniform ivec2 u_image_size;        // output size
 uniform ivec2 u_full_size;         // G-buffer size
 uniform int u_scale;               // G-buffer pixels per output texel (1, 2, 4)
 uniform vec2 u_rotation;           // (cos φ, sin φ) of the cone set's turn about the normal (temporal jitter)
-#if defined(MODE_FIXUP)
+#if defined(MODE_MARKED)
 layout(rgba32f, binding = 0) uniform image2D u_indirect;
 #else
 layout(rgba32f, binding = 0) uniform writeonly image2D u_indirect;
@@ -64,12 +65,10 @@ void main() {
         return;
     }
 #endif
-#if defined(MODE_FIXUP)
+#if defined(MODE_MARKED)
     if (imageLoad(u_indirect, px).a >= 0.0) return;
-    ivec2 src = px;
-#else
-    ivec2 src = min(px * u_scale + u_scale / 2, u_full_size - 1);
 #endif
+    ivec2 src = min(px * u_scale + u_scale / 2, u_full_size - 1);
     vec4 pos = texelFetch(u_position, src, 0);
     if (pos.w < 0.5) {
 #if defined(MODE_RECORD)

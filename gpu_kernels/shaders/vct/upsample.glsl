@@ -10,7 +10,7 @@
 //   normal  max(n·n_j, 0)^8 (a 30° crease keeps 0.32 of its weight, a right angle none; the cosine-weighted gather
 //           itself turns with the normal).
 // Where no texel lies on the pixel's surface (Σ weight < 1e-3: thin objects, silhouettes) the pixel is marked
-// (a = −1) and vct/trace.glsl MODE_FIXUP traces it at full resolution, so no pixel takes another surface's light.
+// (a = −1) and vct/trace.glsl MODE_MARKED traces it at full resolution, so no pixel takes another surface's light.
 layout(local_size_x = 8, local_size_y = 8) in;
 uniform sampler2D u_low;           // rgba: Diffuse Indirect, AO at ceil(W/s) × ceil(H/s)
 uniform sampler2D u_position;      // full-resolution G-buffer: xyz world position, w hit flag
