@@ -26,10 +26,15 @@ NORMAL_COS = 0.999  # 2.6°: a curved surface's samples a texel apart differ by 
 PLANE_VOXELS = 0.05  # of a voxel: two surfaces closer than that share every voxel their cones read
 
 
+def enabled(gbuffer, s: VctSettings) -> bool:
+    """Whether traces of this G-buffer keep what a later view may reuse: a camera's view, a reach, no accumulation."""
+    return s.reuse_reach > 0 and s.temporal_frames <= 1 and gbuffer.view_projection is not None
+
+
 def last_view(cache, key: tuple, gbuffer, s: VctSettings) -> dict | None:
     """The kept vct_trace output whose gathers a trace keyed `key` (((gbuffer, bounce, trace settings), frame))
-    may take: another view of the same volumes, trace settings and accumulation frame, or None."""
-    if s.reuse_reach <= 0 or s.temporal_frames > 1 or gbuffer.view_projection is None:
+    may take: another camera view of the same volumes, trace settings and accumulation frame, or None."""
+    if not enabled(gbuffer, s):
         return None
     (_, volumes, settings), frame = key
 
@@ -42,7 +47,9 @@ def last_view(cache, key: tuple, gbuffer, s: VctSettings) -> dict | None:
 def trace_view(ctx, programs, gbuffer, faces, volumes, s: VctSettings, rotation_deg, hits, last: dict | None) -> dict:
     """vct_trace's output for this view: the samples reused from `last` (last_view) and the others traced, or,
     with no last view, the full trace (recording or replaying `hits`); with the samples' origins for the next view
-    and the count of reused samples."""
+    and the count of reused samples (the plain trace where reuse is not enabled)."""
+    if not enabled(gbuffer, s):
+        return trace(ctx, programs, gbuffer, faces, volumes, s, rotation_deg, hits)
     out = _reproject(ctx, programs, gbuffer, s, last, volumes.grid.cell)
     if last is None:
         traced = trace(ctx, programs, gbuffer, faces, volumes, s, rotation_deg, hits, out=out["indirect"])

@@ -184,3 +184,14 @@ def test_reuse_off_traces_every_sample():
 def test_a_reach_out_of_range_is_one_clear_message(reach):
     with pytest.raises(ValueError, match="reuse_reach .* out of range 0..2 texels"):
         VctSettings(reuse_reach=reach)
+
+
+def test_a_render_after_the_viewports_surface_atlas_reuses_nothing_of_it():
+    """The live viewport traces a surface atlas (no camera): nothing of it is a view to reproject."""
+    engine = Engine()
+    try:
+        engine.submit_surface(_view(0.0), SETTINGS, 4096).result()
+        assert "origin" not in engine.pipeline.cache.entries["vct_trace"].value
+        assert engine.render(_view(0.0), SETTINGS).info["reused_texels"] == 0
+    finally:
+        engine.shutdown()
