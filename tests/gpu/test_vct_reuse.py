@@ -24,14 +24,15 @@ SETTINGS = RenderSettings("vct", *SIZE, vct=VctSettings(resolution=32))
 EYE, TARGET = np.array([0.0, -0.95, 1.0]), np.array([0.0, 0.5, 0.6])
 
 
-def _view(dx=0.0, scene=None, lamp=None):
+def _view(dx=0.0, scene=None, lamp=None, ortho=False):
     """The room with a box by its wall (box's near side in view), seen from EYE moved `dx` m to the side."""
     scene = scene or room_with_box(0.0, size=0.5)
     if lamp is not None:
         scene.lights[0].matrix_world[:3, 3] = lamp
     offset = np.array([dx, 0.0, 0.0])
     c2w = np.linalg.inv(cam.look_at(EYE + offset, TARGET + offset, (0, 0, 1)))
-    return replace(scene, camera=Camera(c2w, lens=12.0))
+    camera = Camera(c2w, type="ORTHO", ortho_scale=1.8) if ortho else Camera(c2w, lens=12.0)
+    return replace(scene, camera=camera)
 
 
 def _trace_output(engine):
@@ -83,14 +84,15 @@ def moved():
         engine.shutdown()
 
 
-def test_a_still_camera_nudged_reuses_every_sample_as_it_was():
+@pytest.mark.parametrize("ortho", (False, True), ids=("perspective", "orthographic"))
+def test_a_still_camera_nudged_reuses_every_sample_as_it_was(ortho):
     """A move of a micrometre: every sample finds its own last gather (at distance ~0), so the traced texture is
     the last one exactly and nothing is traced."""
     engine = Engine()
     try:
-        engine.render(_view(0.0), SETTINGS)
+        engine.render(_view(0.0, ortho=ortho), SETTINGS)
         before, _, _, _ = _trace_output(engine)
-        engine.render(_view(1e-6), SETTINGS)
+        engine.render(_view(1e-6, ortho=ortho), SETTINGS)
         after, reused, retraced, _ = _trace_output(engine)
     finally:
         engine.shutdown()
