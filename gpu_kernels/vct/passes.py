@@ -90,9 +90,11 @@ def _per_pixel(frame, faces, bounced, base, grid):
     if s.anisotropic and not accumulating and last is None:
         size = trace.traced_size(gbuffer, s)
         k_hits = tuple(frame.keys[k] for k in ("geometry", "camera", "emission")) + (size, grid, s.key("trace"))
-        # sized from the last record with the same cones (the viewport's draft stage traces fewer)
-        prior = next((v for k, v in cache.kept("vct_hits") if k[-1] == k_hits[-1]), None)
-        hits = cache.run("vct_hits", k_hits, lambda: replay.allocate(ctx, size, prior))
+        if cache.prior("vct_trace", lambda k: k == k_trace) is not None:  # kept: its pool, if it recorded one
+            hits = cache.prior("vct_hits", lambda k: k == k_hits)
+        else:  # sized from the last record with the same cones (the viewport's draft stage traces fewer)
+            prior = next((v for k, v in cache.kept("vct_hits") if k[-1] == k_hits[-1]), None)
+            hits = cache.run("vct_hits", k_hits, lambda: replay.allocate(ctx, size, prior))
     traced = cache.run("vct_trace", k_trace, lambda: reuse.trace_view(ctx, programs, gbuffer, faces, bounced, s,
                                                                       rotation, hits, last))
     info = {**replay.stats(hits), "reused_texels": traced.get("reused", 0)}

@@ -106,7 +106,7 @@ class VctSettings:
             (self.ao_distance >= 0 and math.isfinite(self.ao_distance), "ao_distance must be ≥ 0"),
             (self.indirect_scale in (1, 2, 4), f"indirect_scale {self.indirect_scale} must be 1, 2 or 4"),
             (0 <= self.temporal_frames <= 256, f"temporal_frames {self.temporal_frames} out of range 0..256"),
-            (0.0 <= self.reuse_reach <= 2.0, f"reuse_reach {self.reuse_reach} out of range 0..2 texels"),
+            (0.0 <= self.reuse_reach <= 1.0, f"reuse_reach {self.reuse_reach} out of range 0..1 texels"),
             (math.isfinite(self.cone_rotation), "cone_rotation must be finite"),
         ]
         for ok, message in checks:

@@ -93,7 +93,8 @@ def test_texels_the_pool_cannot_hold_are_traced_again(monkeypatch):
 
 @pytest.mark.parametrize("edit", [dict(block=0.2), dict(eye=(0.1, -0.9, 1.4))], ids=["object move", "camera"])
 def test_moving_geometry_or_the_camera_records_anew(edit):
-    """(A camera move with the last view's gathers reused records nothing: tests/gpu/test_vct_reuse.py.)"""
+    """With reuse off: a camera move whose view takes the last one's gathers (vct/reuse.py) traces only part of it
+    and records no hits; tests/gpu/test_vct_reuse.py covers that path."""
     settings = RenderSettings("vct", 40, 30, vct=VctSettings(resolution=32, reuse_reach=0.0))
     engine = Engine()
     try:

@@ -37,15 +37,18 @@ def _view(dx=0.0, scene=None, lamp=None, ortho=False):
 
 def _trace_output(engine):
     """vct_trace's textures and the G-buffer's position and normal at the traced samples, as arrays (rows
-    bottom-up), and its reuse counts and view."""
+    top-down, read_texture's order), and its reuse counts and view."""
     def grab(ctx):
         value = engine.pipeline.cache.entries["vct_trace"].value
         arrays = {k: read_texture(value[k], 4).copy() for k in ("indirect", "origin", "origin_normal")}
         gbuffer = engine.pipeline.cache.entries["gbuffer"].value
         scale = SETTINGS.vct.indirect_scale
-        for name in ("position", "normal"):
+        h, w = arrays["origin"].shape[:2]
+        rows, cols = (np.minimum(np.arange(k) * scale + scale // 2, n - 1) for k, n in ((h, gbuffer.size[1]),
+                                                                                        (w, gbuffer.size[0])))
+        for name in ("position", "normal"):  # at each traced texel's pixel, clamped to the image (vct/trace.glsl)
             gl_rows = read_texture(gbuffer.textures[name], 4)[::-1]  # bottom-up, as the shaders index it
-            arrays[name] = gl_rows[scale // 2::scale, scale // 2::scale][::-1].copy()
+            arrays[name] = gl_rows[rows][:, cols][::-1].copy()
         return arrays, value["reused"], value["retraced"], value["view_projection"]
     return engine.worker.call(grab)
 
@@ -84,15 +87,18 @@ def moved():
         engine.shutdown()
 
 
-@pytest.mark.parametrize("ortho", (False, True), ids=("perspective", "orthographic"))
-def test_a_still_camera_nudged_reuses_every_sample_as_it_was(ortho):
-    """A move of a micrometre: every sample finds its own last gather (at distance ~0), so the traced texture is
-    the last one exactly and nothing is traced."""
+@pytest.mark.parametrize("ortho, size", [(False, SIZE), (True, SIZE), (False, (81, 61))],
+                         ids=("perspective", "orthographic", "odd size"))
+def test_a_still_camera_nudged_reuses_every_sample_as_it_was(ortho, size):
+    """A move of a micrometre: every sample finds its own last gather (at distance ~0; a reach of a quarter texel
+    here, so the last column and row, whose samples sit at the image's edge, must be measured there too), so the
+    traced texture is the last one exactly and nothing is traced."""
+    settings = RenderSettings("vct", *size, vct=VctSettings(resolution=32, reuse_reach=0.25))
     engine = Engine()
     try:
-        engine.render(_view(0.0, ortho=ortho), SETTINGS)
+        engine.render(_view(0.0, ortho=ortho), settings)
         before, _, _, _ = _trace_output(engine)
-        engine.render(_view(1e-6, ortho=ortho), SETTINGS)
+        engine.render(_view(1e-6, ortho=ortho), settings)
         after, reused, retraced, _ = _trace_output(engine)
     finally:
         engine.shutdown()
@@ -120,15 +126,19 @@ def test_every_reused_value_was_traced_on_its_samples_surface_within_reach(moved
     hit = o[..., 3] > 0.5
     assert np.array_equal(hit, out["position"][..., 3] > 0.5)
     clip = np.concatenate([o[..., :3], np.ones(o.shape[:2] + (1,))], -1) @ np.asarray(view_projection).T
-    texel = ((clip[..., :2] / clip[..., 3:] * 0.5 + 0.5) * np.array(SIZE) - 0.5 - scale // 2) / scale
+    pixel = (clip[..., :2] / clip[..., 3:] * 0.5 + 0.5) * np.array(SIZE)
     rows, cols = np.indices(o.shape[:2])
     rows = o.shape[0] - 1 - rows  # the arrays' rows top-down, texel coordinates bottom-up
-    assert np.hypot(texel[..., 0] - cols, texel[..., 1] - rows)[hit].max() <= s.reuse_reach + 1e-3
+    src = np.minimum(np.stack([cols, rows], -1) * scale + scale // 2, np.array(SIZE) - 1) + 0.5  # the sample's pixel
+    assert (np.hypot(*np.moveaxis(pixel - src, -1, 0)) / scale)[hit].max() <= s.reuse_reach + 1e-3
     n = n / np.linalg.norm(n, axis=-1, keepdims=True).clip(1e-12)
     assert (np.sum(n * out["origin_normal"][..., :3], -1)[hit] >= reuse.NORMAL_COS - 1e-6).all()
     assert (np.abs(np.sum(n * (o[..., :3] - p), -1))[hit] <= reuse.PLANE_VOXELS * cell + 1e-6).all()
-    values = {tuple(v) for v in last["indirect"].reshape(-1, 4)}
-    assert sum(tuple(v) in values for v in out["indirect"][hit]) >= reused
+    # each reused value is the one the last view held with the same origin (an origin and a value copied together)
+    held = {tuple(o_): tuple(v) for o_, v in zip(last["origin"].reshape(-1, 4), last["indirect"].reshape(-1, 4))}
+    carried = hit & ~np.all(o == out["position"], axis=-1)  # not traced at its own point
+    assert carried.sum() >= reused - 2  # (a reused origin may coincide with the sample's own point)
+    assert all(held.get(tuple(o_)) == tuple(v) for o_, v in zip(o[carried], out["indirect"][carried]))
 
 
 def test_traced_texels_are_a_full_traces_and_the_image_is_close_to_one(moved):
@@ -138,8 +148,9 @@ def test_traced_texels_are_a_full_traces_and_the_image_is_close_to_one(moved):
     reused value moves by up to reuse_reach texels, the upsampling blends values a texel away, and both differ by
     the trace's variation from point to point. Measured here: rel-L1 0.0110 against 0.0086, and 31 pixels more
     than 20% off against the upsampling's 36. A value taken from another surface is what this guards against: with
-    the surface tests off, 0.0135 and 53 pixels. Bounds: 1.5 times the upsampling's rel-L1, and no more pixels far
-    off than it has."""
+    the surface tests off, 0.0135 and 53 pixels: the pixel count is the sharper guard. Bounds: 1.4 times the
+    upsampling's rel-L1, and no more pixels far off than it has. (Bit for bit on one driver: the traced texels come
+    from another build of vct/trace.glsl, MODE_MARKED, than the full trace's, MODE_RECORD.)"""
     steps, full = moved
     result, (out, _, retraced, _) = steps[-1]
     own = np.all(out["origin"] == full["origin"], axis=-1) & (out["origin"][..., 3] > 0.5)
@@ -156,7 +167,7 @@ def test_traced_texels_are_a_full_traces_and_the_image_is_close_to_one(moved):
     (moved_error, moved_far), (upsampling, upsampling_far) = deviation(result, reduced), deviation(reduced, each)
     print(f"reused image vs full trace {moved_error:.4f}, {moved_far} px > 20%; reduced resolution vs every pixel "
           f"{upsampling:.4f}, {upsampling_far} px")
-    assert moved_error <= 1.5 * upsampling and moved_far <= upsampling_far
+    assert moved_error <= 1.4 * upsampling and moved_far <= upsampling_far
 
 
 def test_a_light_edit_after_a_camera_move_traces_the_view_again():
@@ -172,6 +183,20 @@ def test_a_light_edit_after_a_camera_move_traces_the_view_again():
         engine.shutdown()
 
 
+def test_an_unchanged_view_after_a_reused_one_makes_no_pool():
+    """Rendering a reused view again changes nothing: no empty pool of hits is made for it (only a trace fills one)."""
+    engine = Engine()
+    try:
+        engine.render(_view(0.0), SETTINGS)
+        engine.render(_view(0.02), SETTINGS)
+        pools = [v for _, v in engine.pipeline.cache.kept("vct_hits")]
+        again = engine.render(_view(0.02), SETTINGS)
+        assert "vct_trace" in again.skipped
+        assert [v for _, v in engine.pipeline.cache.kept("vct_hits")] == pools
+    finally:
+        engine.shutdown()
+
+
 def test_reuse_off_traces_every_sample():
     settings = RenderSettings("vct", *SIZE, vct=VctSettings(resolution=32, reuse_reach=0.0))
     engine = Engine()
@@ -182,9 +207,9 @@ def test_reuse_off_traces_every_sample():
         engine.shutdown()
 
 
-@pytest.mark.parametrize("reach", (-0.5, 2.5, float("nan")))
+@pytest.mark.parametrize("reach", (-0.5, 1.5, float("nan")))
 def test_a_reach_out_of_range_is_one_clear_message(reach):
-    with pytest.raises(ValueError, match="reuse_reach .* out of range 0..2 texels"):
+    with pytest.raises(ValueError, match="reuse_reach .* out of range 0..1 texels"):
         VctSettings(reuse_reach=reach)
 
 

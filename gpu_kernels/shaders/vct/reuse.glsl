@@ -7,9 +7,10 @@
 // i·s + s/2). Its point p is projected into the last view, and of the 3 × 3 last samples around it the one kept is
 // the gather made (its origin: the point it was traced at, carried along when reused again)
 //   - on p's surface: normals within u_normal_cos, each point within u_plane metres of the other's tangent plane;
-//   - nearest to p's texel as the new camera sees it, and no farther than u_reach texels (VctSettings.reuse_reach:
-//     the upsampling, vct/upsample.glsl, already blends samples a texel apart on one surface). The distance is from
-//     the origin, never from the last texel, so a value reused over many moves never drifts further.
+//   - nearest to p as the new camera sees it, and no farther than u_reach texels (VctSettings.reuse_reach, ≤ 1:
+//     the upsampling, vct/upsample.glsl, already blends samples a texel apart on one surface; the 3 × 3 searched
+//     hold every last sample within a texel of p's projection). The distance is from the origin, never from the last
+//     texel, so a value reused over many moves never drifts further.
 // A texel no last sample passes for is marked (a = −1) and traced (vct/trace.glsl MODE_MARKED). Without a last
 // view (MODE_SEED) every texel is marked and only the origins are written.
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -34,18 +35,19 @@ uniform float u_reach;             // texels of this view
 uniform float u_plane;             // metres
 uniform float u_normal_cos;
 
-// Where world point x falls in a traced image of `size` texels over a G-buffer of `full` pixels (texel units, its
-// texels' centres at whole numbers), or a far-off point if x lies behind that camera.
-vec2 texel_of(mat4 view_projection, vec3 x, ivec2 full) {
+// Where world point x falls on a G-buffer of `full` pixels (pixel units, pixel i's centre at i + 0.5), or a far-off
+// point if x lies behind that camera.
+vec2 pixel_of(mat4 view_projection, vec3 x, ivec2 full) {
     vec4 clip = view_projection * vec4(x, 1.0);
     if (clip.w <= 0.0) return vec2(-1e9);
-    vec2 pixel = (clip.xy / clip.w * 0.5 + 0.5) * vec2(full);
-    return (pixel - 0.5 - float(u_scale / 2)) / float(u_scale);
+    return (clip.xy / clip.w * 0.5 + 0.5) * vec2(full);
 }
 
-// The last texel whose gather p may take (see above), or (−1, −1).
-ivec2 last_sample(ivec2 px, vec3 p, vec3 n) {
-    ivec2 centre = ivec2(round(texel_of(u_last_view_projection, p, u_last_full_size)));
+// The last texel whose gather p may take (see above), or (−1, −1). `src`: the G-buffer pixel p was read at (the
+// texel's, clamped to the image), from whose centre the reach is measured.
+ivec2 last_sample(ivec2 src, vec3 p, vec3 n) {
+    vec2 last = (pixel_of(u_last_view_projection, p, u_last_full_size) - 0.5 - float(u_scale / 2)) / float(u_scale);
+    ivec2 centre = ivec2(round(last));
     ivec2 best = ivec2(-1);
     float nearest = u_reach;
     for (int k = 0; k < 9; ++k) {
@@ -56,7 +58,7 @@ ivec2 last_sample(ivec2 px, vec3 p, vec3 n) {
         vec3 on = texelFetch(u_last_normal, j, 0).xyz;
         if (dot(n, on) < u_normal_cos) continue;
         if (max(abs(dot(n, o.xyz - p)), abs(dot(on, p - o.xyz))) > u_plane) continue;
-        float d = distance(texel_of(u_view_projection, o.xyz, u_full_size), vec2(px));
+        float d = distance(pixel_of(u_view_projection, o.xyz, u_full_size), vec2(src) + 0.5) / float(u_scale);
         if (d <= nearest) {
             nearest = d;
             best = j;
@@ -79,7 +81,7 @@ void main() {
     }
     vec3 n = normalize(texelFetch(u_normal, src, 0).xyz);
 #if !defined(MODE_SEED)
-    ivec2 j = last_sample(px, pos.xyz, n);
+    ivec2 j = last_sample(src, pos.xyz, n);
     if (j.x >= 0) {
         atomicAdd(reused, 1u);
         imageStore(u_indirect, px, texelFetch(u_last, j, 0));
