@@ -20,7 +20,7 @@ import numpy as np
 
 from ..gl.bind import bind_named, dispatch_counted, set_uniforms, write_uniform
 from .settings import VctSettings
-from .trace import trace, trace_marked, traced_size
+from .trace import marked_list, trace, trace_marked, traced_size
 
 NORMAL_COS = 0.999  # 2.6°: a curved surface's samples a texel apart differ by more unless it is gently curved
 PLANE_VOXELS = 0.05  # of a voxel: two surfaces closer than that share every voxel their cones read
@@ -54,8 +54,10 @@ def trace_view(ctx, programs, gbuffer, faces, volumes, s: VctSettings, rotation_
     if last is None:
         traced = trace(ctx, programs, gbuffer, faces, volumes, s, rotation_deg, hits, out=out["indirect"])
     else:
-        trace_marked(ctx, programs, gbuffer, faces, volumes, s, out["indirect"], s.indirect_scale, rotation_deg)
+        trace_marked(ctx, programs, gbuffer, faces, volumes, s, out["indirect"], s.indirect_scale, out["listed"],
+                     out["retraced"], rotation_deg)
         traced = {"indirect": out["indirect"], "scale": int(s.indirect_scale), "replayed": False}
+    out.pop("listed").release()
     return {**out, **traced}
 
 
@@ -77,6 +79,8 @@ def _reproject(ctx, programs, gbuffer, s: VctSettings, last: dict | None, cell: 
         write_uniform(prog, "u_last_view_projection", np.asarray(last["view_projection"]).T)
     for i, name in enumerate(("indirect", "origin", "origin_normal")):
         textures[name].bind_to_image(i, read=False, write=True)
+    listed = marked_list(ctx, size)
+    listed.bind_to_storage_buffer(5)
     marked, reused = dispatch_counted(ctx, prog, size, counts=2)
     return {**textures, "view_projection": gbuffer.view_projection, "full_size": tuple(int(n) for n in gbuffer.size),
-            "reused": reused, "retraced": marked}
+            "reused": reused, "retraced": marked, "listed": listed}

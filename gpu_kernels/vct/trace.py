@@ -58,16 +58,28 @@ def trace(ctx, programs, gbuffer, faces: Faces, volumes: ConeVolumes, s: VctSett
     return {"indirect": out, "scale": scale, "replayed": mode == "replay"}
 
 
+MARKED_ROW = 64  # listed texels per row of trace_marked's dispatch (eight SIMD groups of eight on llvmpipe)
+
+
+def marked_list(ctx, size: tuple):
+    """A storage buffer for the texels a pass marks for trace_marked: an ivec2 each, room for every texel of `size`
+    (vct/upsample.glsl and vct/reuse.glsl list them on binding 5)."""
+    return ctx.buffer(reserve=8 * max(int(size[0]) * int(size[1]), 1))
+
+
 def trace_marked(ctx, programs, gbuffer, faces: Faces, volumes: ConeVolumes, s: VctSettings, texture, scale: int,
-                 rotation_deg: float | None = None) -> None:
-    """Trace, in place, the texels of `texture` marked a < 0 (vct/trace.glsl MODE_MARKED): at full resolution
-    (`scale` 1) the pixels vct/upsample.glsl marked, at indirect_scale the texels vct/reuse.glsl found no gather
-    of the last view for."""
+                 listed, count: int, rotation_deg: float | None = None) -> None:
+    """Trace, in place, the `count` texels of `texture` listed in `listed` (marked_list; vct/trace.glsl
+    MODE_MARKED), one per invocation: at full resolution (`scale` 1) the pixels vct/upsample.glsl marked, at
+    indirect_scale the texels vct/reuse.glsl found no gather of the last view for."""
+    if count <= 0:
+        return
     prog = trace_program(programs, gbuffer, faces, volumes, s, rotation_deg, marked=True)
-    set_uniform(prog, "u_image_size", tuple(texture.size))
-    set_uniform(prog, "u_scale", int(scale))
-    texture.bind_to_image(0, read=True, write=True)
-    dispatch(prog, tuple(texture.size), local=8)
+    set_uniforms(prog, {"u_image_size": tuple(texture.size), "u_scale": int(scale), "u_marked": int(count),
+                        "u_list_width": MARKED_ROW})
+    texture.bind_to_image(0, read=False, write=True)
+    listed.bind_to_storage_buffer(5)
+    dispatch(prog, (MARKED_ROW, -(-int(count) // MARKED_ROW)), local=8)
     ctx.memory_barrier()
 
 

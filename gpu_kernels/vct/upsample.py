@@ -11,7 +11,7 @@ benchmarks/vct_bench.py.
 from __future__ import annotations
 
 from ..gl.bind import bind_samplers, dispatch_counted, set_uniforms
-from .trace import trace_marked
+from .trace import marked_list, trace_marked
 
 SIGMA_VOXELS = 0.5  # plane-distance scale in voxels (vct/upsample.glsl says why)
 
@@ -19,17 +19,28 @@ SIGMA_VOXELS = 0.5  # plane-distance scale in voxels (vct/upsample.glsl says why
 def upsample(ctx, programs, gbuffer, low: dict, faces, volumes, s, rotation_deg=None) -> dict:
     """{'indirect': full-resolution RGBA32F texture (rgb Diffuse Indirect, a AO), 'fixup': pixels traced again at
     full resolution}. `low` is vct/trace.trace's output at s.indirect_scale."""
-    out, marked = joint_bilateral(ctx, programs, gbuffer, low["indirect"], int(low["scale"]),
-                                  SIGMA_VOXELS * volumes.grid.cell)
-    if marked:
-        trace_marked(ctx, programs, gbuffer, faces, volumes, s, out, 1, rotation_deg)
+    listed = marked_list(ctx, gbuffer.size)
+    try:
+        out, marked = joint_bilateral(ctx, programs, gbuffer, low["indirect"], int(low["scale"]),
+                                      SIGMA_VOXELS * volumes.grid.cell, listed)
+        trace_marked(ctx, programs, gbuffer, faces, volumes, s, out, 1, listed, marked, rotation_deg)
+    finally:
+        listed.release()
     return {"indirect": out, "fixup": marked}
 
 
-def joint_bilateral(ctx, programs, gbuffer, low, scale: int, sigma: float):
-    """vct/upsample.glsl alone: (full-resolution RGBA32F texture, pixels marked a = −1 for a full-resolution trace).
-    `low` holds the values at G-buffer pixels i·scale + scale/2; `sigma` is the plane-distance scale (m)."""
+def joint_bilateral(ctx, programs, gbuffer, low, scale: int, sigma: float, listed=None):
+    """vct/upsample.glsl alone: (full-resolution RGBA32F texture, pixels marked a = −1 for a full-resolution trace,
+    listed in `listed` where given: trace.marked_list). `low` holds the values at G-buffer pixels i·scale + scale/2;
+    `sigma` is the plane-distance scale (m)."""
     w, h = gbuffer.size
+    if listed is None:  # the shader lists the marked pixels all the same
+        listed = marked_list(ctx, gbuffer.size)
+        try:
+            return joint_bilateral(ctx, programs, gbuffer, low, scale, sigma, listed)
+        finally:
+            listed.release()
+    listed.bind_to_storage_buffer(5)
     out = ctx.texture((w, h), 4, dtype="f4")
     prog = programs.compute("vct/upsample.glsl")
     unit = bind_samplers(prog, "u_low", [low], 0)

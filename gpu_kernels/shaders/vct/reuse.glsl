@@ -24,6 +24,7 @@ layout(rgba32f, binding = 0) uniform writeonly image2D u_indirect;  // rgb Diffu
 layout(rgba32f, binding = 1) uniform writeonly image2D u_origin;    // xyz where the value was traced, w hit flag
 layout(rgba32f, binding = 2) uniform writeonly image2D u_origin_normal;
 layout(std430, binding = 3) buffer Counter { uint marked; uint reused; };
+layout(std430, binding = 5) writeonly buffer MarkedList { ivec2 marked_texels[]; };  // for vct/trace.glsl MODE_MARKED
 #if !defined(MODE_SEED)
 uniform sampler2D u_last;          // the last view's traced texture, its origins and their normals
 uniform sampler2D u_last_origin;
@@ -90,7 +91,7 @@ void main() {
         return;
     }
 #endif
-    atomicAdd(marked, 1u);
+    marked_texels[atomicAdd(marked, 1u)] = px;
     imageStore(u_indirect, px, vec4(0.0, 0.0, 0.0, -1.0));
     imageStore(u_origin, px, vec4(pos.xyz, 1.0));
     imageStore(u_origin_normal, px, vec4(n, 0.0));

@@ -8,9 +8,11 @@
 // ceil(H/s) and output texel i gathers at full-resolution pixel i·s + s/2 (clamped to the image), so every traced
 // sample lies exactly on a G-buffer pixel and vct/upsample.glsl can compare its position and normal with its
 // neighbours'.
-// MODE_MARKED: in place, only the texels marked a < 0 are traced; the rest keep their value. At full resolution
-// (u_scale 1) the pixels vct/upsample.glsl marked (no low-resolution sample lies on their surface); at the reduced
-// one the texels vct/reuse.glsl found no gather of the last view for.
+// MODE_MARKED: in place, only the marked texels are traced, listed by the pass that marked them (storage buffer 5,
+// u_marked of them, u_list_width a row of the dispatch): at full resolution (u_scale 1) the pixels
+// vct/upsample.glsl marked (no low-resolution sample lies on their surface); at the reduced one the texels
+// vct/reuse.glsl found no gather of the last view for. One marked texel per invocation: swept over the image, a
+// SIMD group holding one marked texel among idle lanes cost as much as eight (the fix-ups: 30-60 ms of 100).
 // MODE_RECORD: the trace, keeping every texel's sub-ray hits (vct/hits.glsl); MODE_REPLAY: the same image from
 // those hits and the current volumes, a texel the record could not keep traced again.
 #include "vct/common.glsl"
@@ -24,7 +26,10 @@ uniform ivec2 u_full_size;         // G-buffer size
 uniform int u_scale;               // G-buffer pixels per output texel (1, 2, 4)
 uniform vec2 u_rotation;           // (cos φ, sin φ) of the cone set's turn about the normal (temporal jitter)
 #if defined(MODE_MARKED)
-layout(rgba32f, binding = 0) uniform image2D u_indirect;
+layout(rgba32f, binding = 0) uniform writeonly image2D u_indirect;
+layout(std430, binding = 5) readonly buffer MarkedList { ivec2 marked_texels[]; };
+uniform int u_marked;
+uniform int u_list_width;
 #else
 layout(rgba32f, binding = 0) uniform writeonly image2D u_indirect;
 #endif
@@ -51,8 +56,14 @@ vec3 replay(uvec4 header) {
 #endif
 
 void main() {
+#if defined(MODE_MARKED)
+    int listed = int(gl_GlobalInvocationID.y) * u_list_width + int(gl_GlobalInvocationID.x);
+    if (int(gl_GlobalInvocationID.x) >= u_list_width || listed >= u_marked) return;
+    ivec2 px = marked_texels[listed];
+#else
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(px, u_image_size))) return;
+#endif
     uint texel = uint(px.y * u_image_size.x + px.x);
 #if defined(MODE_REPLAY)
     uvec4 header = hit_headers[texel];
@@ -64,9 +75,6 @@ void main() {
         imageStore(u_indirect, px, vec4(replay(header) / VCT_PI, uintBitsToFloat(header.z)));
         return;
     }
-#endif
-#if defined(MODE_MARKED)
-    if (imageLoad(u_indirect, px).a >= 0.0) return;
 #endif
     ivec2 src = min(px * u_scale + u_scale / 2, u_full_size - 1);
     vec4 pos = texelFetch(u_position, src, 0);

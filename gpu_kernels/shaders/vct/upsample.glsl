@@ -21,6 +21,7 @@ uniform int u_scale;
 uniform float u_sigma;             // plane-distance scale (m)
 layout(rgba32f, binding = 0) uniform writeonly image2D u_out;
 layout(std430, binding = 3) buffer Counter { uint marked; };
+layout(std430, binding = 5) writeonly buffer MarkedList { ivec2 marked_texels[]; };  // for vct/trace.glsl MODE_MARKED
 
 void main() {
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
@@ -54,7 +55,7 @@ void main() {
         wsum += w;
     }
     if (wsum < 1e-3) {
-        atomicAdd(marked, 1u);
+        marked_texels[atomicAdd(marked, 1u)] = px;
         imageStore(u_out, px, vec4(0.0, 0.0, 0.0, -1.0));
         return;
     }
