@@ -34,12 +34,8 @@ def joint_bilateral(ctx, programs, gbuffer, low, scale: int, sigma: float, liste
     listed in `listed` where given: trace.marked_list). `low` holds the values at G-buffer pixels i·scale + scale/2;
     `sigma` is the plane-distance scale (m)."""
     w, h = gbuffer.size
-    if listed is None:  # the shader lists the marked pixels all the same
-        listed = marked_list(ctx, gbuffer.size)
-        try:
-            return joint_bilateral(ctx, programs, gbuffer, low, scale, sigma, listed)
-        finally:
-            listed.release()
+    own = listed is None  # the shader lists the marked pixels all the same
+    listed = marked_list(ctx, gbuffer.size) if own else listed
     listed.bind_to_storage_buffer(5)
     out = ctx.texture((w, h), 4, dtype="f4")
     prog = programs.compute("vct/upsample.glsl")
@@ -49,4 +45,8 @@ def joint_bilateral(ctx, programs, gbuffer, low, scale: int, sigma: float, liste
     set_uniforms(prog, {"u_image_size": (w, h), "u_low_size": tuple(low.size), "u_scale": int(scale),
                         "u_sigma": float(sigma)})
     out.bind_to_image(0, read=False, write=True)
-    return out, dispatch_counted(ctx, prog, (w, h))
+    try:
+        return out, dispatch_counted(ctx, prog, (w, h))
+    finally:
+        if own:
+            listed.release()

@@ -12,7 +12,7 @@
 // u_marked of them, u_list_width a row of the dispatch): at full resolution (u_scale 1) the pixels
 // vct/upsample.glsl marked (no low-resolution sample lies on their surface); at the reduced one the texels
 // vct/reuse.glsl found no gather of the last view for. One marked texel per invocation: swept over the image, a
-// SIMD group holding one marked texel among idle lanes cost as much as eight (the fix-ups: 30-60 ms of 100).
+// SIMD group holding one marked texel among idle lanes cost as much as eight.
 // MODE_RECORD: the trace, keeping every texel's sub-ray hits (vct/hits.glsl); MODE_REPLAY: the same image from
 // those hits and the current volumes, a texel the record could not keep traced again.
 #include "vct/common.glsl"
@@ -25,13 +25,11 @@ uniform ivec2 u_image_size;        // output size
 uniform ivec2 u_full_size;         // G-buffer size
 uniform int u_scale;               // G-buffer pixels per output texel (1, 2, 4)
 uniform vec2 u_rotation;           // (cos φ, sin φ) of the cone set's turn about the normal (temporal jitter)
-#if defined(MODE_MARKED)
 layout(rgba32f, binding = 0) uniform writeonly image2D u_indirect;
+#if defined(MODE_MARKED)
 layout(std430, binding = 5) readonly buffer MarkedList { ivec2 marked_texels[]; };
 uniform int u_marked;
 uniform int u_list_width;
-#else
-layout(rgba32f, binding = 0) uniform writeonly image2D u_indirect;
 #endif
 
 #if defined(MODE_REPLAY)
