@@ -23,46 +23,27 @@ COVER_TEST_BYTES = 256 * 2 ** 20  # the front-most images' budget (32 MiB at 64Â
 
 
 def inject(ctx, programs, scene: Scene, geometry, textures: list, vox, shadows, levels: int,
-           shared: VoxelGeometry | None = None) -> Faces:
+           shared: VoxelGeometry | None = None, scratch: dict | None = None) -> Faces:
     """Direct light reflected through every voxel face: surface points rasterised along their dominant axis and lit
     exactly as in direct/light.glsl (vct/inject_raster.glsl), then averaged per face (vct/inject.glsl). The faces'
-    centroids are taken from `shared` where it holds them, else made and left there."""
-    import moderngl
-
+    centroids are taken from `shared` where it holds them, else made and left there. `scratch` (a dict; none: made
+    and released here) keeps the accumulator and the front-most surfaces for the next injection of the same voxels
+    with other lights (vct/parts.py): the caller releases it (release_scratch)."""
     grid = vox.grid
-    nx, ny, nz = grid.size
     kept = shared is not None and shared.centroids is not None
     faces = Faces([texture3d(ctx, grid.size, zero=True) for _ in range(6)], grid, levels,
                   centroids=shared.centroids if kept else [texture3d(ctx, grid.size, zero=True) for _ in range(6)],
                   centroids_owned=not kept)
-    acc = ctx.texture3d((8 * nx, ny, 6 * nz), 1, dtype="u4")
-    acc.filter = (moderngl.NEAREST, moderngl.NEAREST)
+    own = scratch is None
+    scratch = {} if own else scratch
     try:
-        clear = programs.compute("vct/inject.glsl", {"MODE_CLEAR": None})
-        acc.bind_to_image(0, read=False, write=True)
-        set_uniform(clear, "u_grid_size", grid.size)
-        dispatch(clear, grid.size)
-        ctx.memory_barrier()
-
+        acc = _accumulator(ctx, grid, scratch)
         side = max(grid.size) * INJECT_SAMPLES
-        fronts = front_images(ctx, grid, side)
-        try:
-            # The front-most surfaces first (MODE_FRONT), then the injection that leaves covered ones out.
-            for defines in (({"MODE_FRONT": None},) if fronts else ()) + ({},):
-                prog = programs.raster("vct/inject_raster.glsl", {**defines, **shadows.defines})
-                bind_grid(prog, grid, 1)
-                bind_lights(prog, shadows, unit=2, sky_stride=SKY_INJECTION_STRIDE)
-                set_uniforms(prog, {"u_samples": float(INJECT_SAMPLES), "u_viewport": (float(side), float(side)),
-                                    "u_cover_test": bool(fronts)})
-                acc.bind_to_image(0, read=True, write=True)
-                for i, t in enumerate(fronts):
-                    t.bind_to_image(1 + i, read=True, write=True)
-                _rasterise(ctx, prog, scene, geometry, textures, side)
-                ctx.memory_barrier()
-        finally:
-            for t in fronts:
-                t.release()
-
+        if "fronts" not in scratch:  # the front-most surfaces first (MODE_FRONT): the geometry's, whatever the lights
+            scratch["fronts"] = front_images(ctx, grid, side)
+            if scratch["fronts"]:
+                _raster_pass(ctx, programs, {"MODE_FRONT": None}, (scene, geometry, textures), shadows, grid, scratch)
+        _raster_pass(ctx, programs, {}, (scene, geometry, textures), shadows, grid, scratch)
         for outputs, defines in ((faces.textures, {}),) + (() if kept else ((faces.centroids,
                                                                               {"WRITE_CENTROIDS": None}),)):
             prog = _resolve_program(programs, {"MODE_RESOLVE": None, **defines}, vox, acc, shadows, grid, outputs)
@@ -72,11 +53,48 @@ def inject(ctx, programs, scene: Scene, geometry, textures: list, vox, shadows, 
             else:
                 _light_fallback_faces(ctx, programs, prog, vox, acc, shadows, grid, outputs)
     finally:
-        acc.release()
+        if own:
+            release_scratch(scratch)
     faces.flux, faces.occupied, faces.missed = face_flux(ctx, programs, faces)
     if shared is not None and not kept:
         shared.centroids, faces.centroids_owned = faces.centroids, False
     return faces
+
+
+def _accumulator(ctx, grid, scratch: dict):
+    """The raster's sums (vct/inject_raster.glsl), zeroed: `scratch`'s, or made and left there."""
+    import moderngl
+
+    if "acc" not in scratch:
+        nx, ny, nz = grid.size
+        scratch["acc"] = ctx.texture3d((8 * nx, ny, 6 * nz), 1, dtype="u4")
+        scratch["acc"].filter = (moderngl.NEAREST, moderngl.NEAREST)
+    zero_texture(ctx, scratch["acc"])
+    return scratch["acc"]
+
+
+def release_scratch(scratch: dict) -> None:
+    """Release what inject() left in `scratch`."""
+    for t in [scratch.pop("acc", None)] + list(scratch.pop("fronts", None) or []):
+        if t is not None:
+            t.release()
+
+
+def _raster_pass(ctx, programs, defines: dict, drawn: tuple, shadows, grid, scratch: dict) -> None:
+    """vct/inject_raster.glsl in mode `defines` over every triangle of `drawn` = (scene, geometry, textures), into
+    the scratch's accumulator and front-most images."""
+    side = max(grid.size) * INJECT_SAMPLES
+    fronts = scratch["fronts"]
+    prog = programs.raster("vct/inject_raster.glsl", {**defines, **shadows.defines})
+    bind_grid(prog, grid, 1)
+    bind_lights(prog, shadows, unit=2, sky_stride=SKY_INJECTION_STRIDE)
+    set_uniforms(prog, {"u_samples": float(INJECT_SAMPLES), "u_viewport": (float(side), float(side)),
+                        "u_cover_test": bool(fronts)})
+    scratch["acc"].bind_to_image(0, read=True, write=True)
+    for i, t in enumerate(fronts):
+        t.bind_to_image(1 + i, read=True, write=True)
+    _rasterise(ctx, prog, *drawn, side)
+    ctx.memory_barrier()
 
 
 def _resolve_program(programs, defines: dict, vox, acc, shadows, grid, outputs):

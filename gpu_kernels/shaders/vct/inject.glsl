@@ -17,23 +17,13 @@
 // Emission is not injected: emissive triangles are lights (common/lights.py), so E already carries their light,
 // and adding it again would count it twice (Cycles' Diffuse Indirect never holds emission). A closed emitter emits
 // outwards only (common/emitters.py): its inner light would leak out of the voxels.
-// MODE_CLEAR zeroes the accumulator; MODE_RESOLVE writes the faces: rgb = L_g, a = α_g, and centroids: xyz = c_g,
+// The accumulator starts zeroed (gl/bind.zero_texture). MODE_RESOLVE writes the faces: rgb = L_g, a = α_g, and centroids: xyz = c_g,
 // w = α_g (or the face centre and w = −α_g for a fallback face; w = 0 where the voxel has no surface);
 // MODE_FALLBACK lights the fallback faces the resolve listed.
 #if !defined(MODE_FALLBACK)
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;  // gl/bind.VOLUME_GROUP
 #endif
 uniform ivec3 u_grid_size;
-
-#if defined(MODE_CLEAR)
-layout(r32ui, binding = 0) uniform writeonly uimage3D u_acc;
-void main() {
-    ivec3 v = ivec3(gl_GlobalInvocationID);
-    if (any(greaterThanEqual(v, u_grid_size))) return;
-    for (int g = 0; g < 6; ++g)
-        for (int c = 0; c < 8; ++c) imageStore(u_acc, ivec3(8 * v.x + c, v.y, g * u_grid_size.z + v.z), uvec4(0u));
-}
-#endif
 
 #if defined(MODE_RESOLVE) || defined(MODE_FALLBACK)
 #include "common/lights.glsl"
