@@ -70,6 +70,7 @@ def method_bytes(scene: Scene, settings: RenderSettings) -> int:
     """About how many bytes of GPU memory the method's volumes take (0 for "none")."""
     if settings.method == "vct":
         from .vct.inject import front_bytes
+        from .vct.parts import parts_bytes, scene_parts
         from .vct.replay import pool_bytes
         from .vct.volumes import vct_grid
         from .voxel.voxelize import scene_area
@@ -77,7 +78,7 @@ def method_bytes(scene: Scene, settings: RenderSettings) -> int:
         grid, scale = vct_grid(scene, settings.vct), settings.vct.indirect_scale
         traced = (-(-settings.width // scale), -(-settings.height // scale))
         return (grid.voxel_count * VCT_BYTES_PER_VOXEL + front_bytes(grid) + VCT_FIXED_BYTES
-                + pool_bytes(scene_area(scene), grid.cell, traced))
+                + pool_bytes(scene_area(scene), grid.cell, traced) + parts_bytes(grid, scene_parts(scene)))
     if settings.method == "lpv":
         from .lpv.state import cascade_grids
 

@@ -95,6 +95,14 @@ class PassCache:
             return None
         return older.pop().value
 
+    def drop(self, names) -> None:
+        """Release every output kept for the passes `names` (a pass the frame no longer runs, which would otherwise
+        hold its memory until the cache is cleared)."""
+        for name in names:
+            entry = self.entries.pop(name, None)
+            for e in ([entry] if entry is not None else []) + self.older.pop(name, []):
+                release_resources(e.value)
+
     def _retire(self, name: str, entry) -> None:
         """Keep a replaced output among the `keep[name] - 1` older ones, releasing what falls off the end."""
         if entry is None:

@@ -22,8 +22,12 @@ from ..scene import hash_parts
 def colour_scale(shadows) -> np.ndarray:
     """(3,) float32: per channel, the largest colour (colour × power or strength) of the scene's lights; 1 where no
     light has any."""
-    colours = shadows.buffers.lights["color_type"][:, :3]
-    largest = colours.max(axis=0, initial=0.0).astype(np.float32)
+    return largest_colour(shadows.buffers.lights["color_type"][:, :3])
+
+
+def largest_colour(colours: np.ndarray) -> np.ndarray:
+    """(3,) float32: per channel, the largest of `colours` (N, 3); 1 where none is above 0."""
+    largest = np.asarray(colours).max(axis=0, initial=0.0).astype(np.float32)
     return np.where(largest > 0, largest, np.float32(1.0))
 
 
@@ -41,11 +45,11 @@ def unit_key(shadows, records: np.ndarray) -> str:
 
 
 def with_records(ctx, shadows, records: np.ndarray, run):
-    """run(shadows') with shadows' lights `records`, uploaded for the call."""
+    """run(shadows') with shadows' lights `records` (all of them, or some: vct/parts.py), uploaded for the call."""
     buffer = ssbo(ctx, records)
     shadows.raw_depth()  # made on the original, so the copy shares it and nothing is left unreleased
     try:
-        return run(replace(shadows, light_ssbo=buffer))
+        return run(replace(shadows, light_ssbo=buffer, light_count=len(records)))
     finally:
         buffer.release()
 

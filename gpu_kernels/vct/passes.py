@@ -5,7 +5,11 @@
     vct_geometry    ← geometry, emission, grid, levels: what the passes below derive from the geometry alone, made
                       by the first that needs each part and kept across light, world and material colour edits
                       (volumes.VoxelGeometry)
-    vct_inject      ← voxels, shadow maps, the lights per unit of the largest colour (vct/colours.py)
+    vct_inject_lamps, _emitters, _sky
+                    ← voxels, that part's lights' shadow maps and records per unit of its largest colour: where the
+                      lights make more than one part (vct/parts.py)
+    vct_inject      ← voxels, shadow maps, the lights per unit of the largest colour (vct/colours.py); or the parts
+                      and their weights, summed
     vct_mipmap      ← injection, anisotropy
     vct_bounce      ← mipmaps, cone settings, bounces
     vct_specular    ← gbuffer, bounced volumes, specular settings
@@ -24,7 +28,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..common.method import MethodOutput
-from . import bounce, colours, inject, mipmap, replay, reuse, specular, temporal, trace, upsample
+from . import bounce, colours, inject, mipmap, parts, replay, reuse, specular, temporal, trace, upsample
 from .volumes import VoxelGeometry, mip_levels, vct_grid, voxelize_scene
 
 # Outputs kept per pass (gl/pass_cache.py): the voxels, what their geometry decides and the per-pixel hits of two
@@ -47,10 +51,7 @@ def run(frame) -> MethodOutput:
     records = colours.unit_records(frame.shadows, scale)
     shared = cache.run("vct_geometry", (frame.keys["geometry"], frame.keys["emission"], grid.key(), levels),
                        VoxelGeometry)
-    k_inject = (k_vox, colours.unit_key(frame.shadows, records), levels)
-    faces = cache.run("vct_inject", k_inject, lambda: colours.with_records(
-        ctx, frame.shadows, records, lambda shadows: inject.inject(ctx, programs, scene, frame.geometry,
-                                                                   frame.textures, vox, shadows, levels, shared)))
+    faces, k_inject = _inject(frame, vox, shared, (k_vox, levels), scale, records)
     k_mip = (k_inject, s.anisotropic)
     volumes = cache.run("vct_mipmap", k_mip, lambda: mipmap.build_volumes(ctx, programs, faces, s.anisotropic,
                                                                          shared=shared))
@@ -70,6 +71,40 @@ def run(frame) -> MethodOutput:
         key = (k_trace, k_spec, scale.tobytes())
         out = cache.run("vct_scale", key, lambda: colours.scale_output(ctx, list(out), scale))
     return MethodOutput(*out, key, colours.scale_info(info, scale), has_ao=True)
+
+
+def _inject(frame, vox, shared, base: tuple, scale: np.ndarray, records: np.ndarray) -> tuple:
+    """vct_inject: each part of the lights (the lamps, the emissive meshes, the sky) injected in its own pass per unit
+    of its colour and summed with weights (vct/parts.py; one part is taken as it is), or, where the parts' volumes
+    would not fit, every light at once. `base` = (the voxels' key, levels); `records` the lights per unit of
+    `scale`. Returns the faces and their key."""
+    ctx, programs, cache, shadows = frame.ctx, frame.programs, frame.cache, frame.shadows
+    k_vox, levels = base
+    scratch = {}  # the accumulator and front-most surfaces, shared by the parts injected in this frame
+
+    def injected(subset):
+        return colours.with_records(ctx, shadows, subset, lambda sh: inject.inject(
+            ctx, programs, frame.scene, frame.geometry, frame.textures, vox, sh, levels, shared, scratch))
+
+    light_parts = parts.light_parts(shadows)
+    try:
+        if not light_parts or not parts.fits(vox.grid, len(light_parts)):
+            cache.drop([f"vct_inject_{name}" for name in parts.PARTS])
+            k_inject = (k_vox, colours.unit_key(shadows, records), levels)
+            return cache.run("vct_inject", k_inject, lambda: injected(records)), k_inject
+        made, keys = [], []
+        for part in light_parts:
+            subset = parts.part_records(shadows, part)
+            key = (k_vox, parts.part_key(shadows, part, subset), levels)
+            made.append(cache.run(f"vct_inject_{part.name}", key, lambda subset=subset: injected(subset)))
+            keys.append(key)
+    finally:
+        inject.release_scratch(scratch)
+    cache.drop([f"vct_inject_{name}" for name in set(parts.PARTS) - {p.name for p in light_parts}])
+    weights = [part.scale / scale for part in light_parts]
+    k_inject = (tuple(keys), np.asarray(weights, np.float32).tobytes())
+    return cache.run("vct_inject", k_inject, lambda: parts.sum_parts(ctx, programs, made, weights,
+                                                                       shared.centroids)), k_inject
 
 
 def _per_pixel(frame, faces, bounced, base, grid):

@@ -63,9 +63,10 @@ class Faces:
     centroids: list = None  # vct/inject.py only: per face, xyz = where its surface points lie, w = ±α_g
     missed: int = 0  # faces with coverage that caught no raster sample (lit at the face centre instead)
     centroids_owned: bool = True  # False: VoxelGeometry's, kept across light edits
+    owned: bool = True  # False: a view of another pass's faces (vct_inject of a scene with one part, vct/parts.py)
 
     def release(self):
-        for t in self.textures + (self.centroids or [] if self.centroids_owned else []):
+        for t in (self.textures if self.owned else []) + (self.centroids or [] if self.centroids_owned else []):
             t.release()
 
 

@@ -67,6 +67,19 @@ def test_changed_key_reruns_and_releases_old_value():
     assert new.released == 1 and cache.entries == {}
 
 
+def test_drop_releases_every_output_of_a_pass_and_nothing_else():
+    cache, c = PassCache(keep={"a": 2}), Counter()
+    first, second, other = Resource("1"), Resource("2"), Resource("b")
+    cache.run("a", (1,), c.fn("a", first))
+    cache.run("a", (2,), c.fn("a", second))
+    cache.run("b", (1,), c.fn("b", other))
+    cache.drop(["a", "never run"])
+    assert (first.released, second.released, other.released) == (1, 1, 0)
+    assert "a" not in cache.entries and not cache.older.get("a") and cache.kept("b")
+    cache.run("a", (1,), c.fn("a", Resource("again")))
+    assert c.calls["a"] == 3  # made again: nothing of it was kept
+
+
 def test_timing_measures_the_pass_and_waits_for_finish():
     finished = []
     cache = PassCache(finish=lambda: (time.sleep(0.02), finished.append(1)))

@@ -1,0 +1,114 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""vct_inject by parts: the lamps, the emissive meshes and the sky injected apart, each per unit of its own largest
+colour, and summed (vct/inject_sum.glsl).
+
+Why: the injection is linear in the lights (each surface point's light is a sum over them, vct/inject_raster.glsl),
+so the faces of all lights are the sum of the faces of each part, each part's scaled by its colour. A light edit then
+re-injects the part it touched and keeps the others' faces: a lamp's move re-lights the voxels from the lamps alone,
+not from the sky's 144 shadow maps or an emissive mesh's clusters (seconds in a furnished room on llvmpipe). Where
+a part is one light whose colour or power alone changed (the sky's colour or strength, a scene's only lamp), its
+records per unit of its colour are unchanged and nothing is injected: the parts are summed with the new weights.
+The bounces that follow run as after any light edit (vct/replay.py replays them).
+
+A cold render injects and sums the same parts, so it gives what an edit gives. A scene with one part injects it as
+before (its records per unit of its colour are the transport's) and takes its faces as they are, without a copy.
+Each part keeps six face volumes (PART_BYTES_CAP bounds the parts of a scene with more than one): more than fit fall
+back to one injection of every light. A part's key holds its lights' shadow views as packed in the atlas, so a
+light added or removed elsewhere, which moves the maps in the atlas, injects every part again.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from ..common import lights as lb
+from ..common.emitters import emissive_triangles
+from ..gl.bind import bind_samplers, dispatch, set_uniform, texture3d
+from ..scene import Scene, hash_parts
+from .colours import largest_colour
+from .volumes import Faces
+
+PARTS = ("lamps", "emitters", "sky")  # the pass of each is vct_inject_<name>
+PART_BYTES_CAP = 128 * 2 ** 20  # the parts' face volumes together (a part at 64³: 24 MiB)
+FACE_BYTES = 6 * 16  # six RGBA32F face volumes a voxel
+
+
+@dataclass
+class Part:
+    """A group of light records injected together: `lights` their indices, `scale` (3,) their largest colour per
+    channel (1 where none has any), by which the records it injects are divided."""
+    name: str
+    lights: np.ndarray
+    scale: np.ndarray
+
+
+def light_parts(shadows) -> list[Part]:
+    """The non-empty parts of the shadows' light records, in PARTS order: the sky light(s), the emissive meshes'
+    clusters (triangle lists), and every other light (the lamps)."""
+    records = shadows.buffers.lights
+    kinds = records["color_type"][:, 3].astype(int)
+    emitter = (kinds == lb.LIGHT_POLYGON) & (records["polygon"][:, 3] > 0.5)
+    sky = kinds == lb.LIGHT_SKY
+    masks = {"lamps": ~emitter & ~sky, "emitters": emitter, "sky": sky}
+    out = []
+    for name in PARTS:
+        lights = np.flatnonzero(masks[name])
+        if len(lights):
+            out.append(Part(name, lights, largest_colour(records["color_type"][lights, :3])))
+    return out
+
+
+def scene_parts(scene: Scene) -> int:
+    """How many parts `scene`'s lights make (settings.method_bytes: before any light record exists)."""
+    lamps = any(light.power > 0 for light in scene.lights)
+    emitters = len(emissive_triangles(scene)[0]) > 0
+    sky = max(np.asarray(scene.world.color, np.float64)[:3], default=0.0) > 0
+    return int(lamps) + int(emitters) + int(sky)
+
+
+def fits(grid, parts: int) -> bool:
+    """Whether `parts` parts are injected apart on `grid`: one always (it is the injection), more where their
+    face volumes fit PART_BYTES_CAP."""
+    return parts <= 1 or parts * grid.voxel_count * FACE_BYTES <= PART_BYTES_CAP
+
+
+def parts_bytes(grid, parts: int) -> int:
+    """The memory the parts add on `grid`: the sum's face volumes, where there is more than one part and they fit."""
+    return parts * grid.voxel_count * FACE_BYTES if parts > 1 and fits(grid, parts) else 0
+
+
+def part_records(shadows, part: Part) -> np.ndarray:
+    """The part's light records, their colours divided by its scale."""
+    records = shadows.buffers.lights[part.lights].copy()
+    records["color_type"][:, :3] /= part.scale
+    return records
+
+
+def part_key(shadows, part: Part, records: np.ndarray) -> str:
+    """What a part's injection is made of besides the voxels: its lights' maps and records without their colours
+    (direct/shadows.light_signatures) and their colours per unit of its scale."""
+    return hash_parts([shadows.light_keys[i] for i in part.lights], records["color_type"][:, :3])
+
+
+def sum_parts(ctx, programs, parts: list, weights: list, centroids: list) -> Faces:
+    """New faces Σ_p weights[p] ⊙ parts[p] (rgb; the coverage α, the geometry's, from any part), with the kept
+    `centroids` (not owned); their flux the parts' summed alike (the faces the parts lit at their centre and the
+    occupied voxels are the geometry's). One part of weight 1 (it is every light) is taken as it is: a view."""
+    first = parts[0]
+    if len(parts) == 1 and np.all(np.asarray(weights[0]) == 1.0):
+        return replace(first, owned=False, centroids_owned=False)
+    out = Faces([texture3d(ctx, first.grid.size, zero=True) for _ in range(6)], first.grid, first.levels,
+                flux=[float(sum(float(w[c]) * p.flux[c] for p, w in zip(parts, weights))) for c in range(3)],
+                occupied=first.occupied, centroids=centroids, missed=first.missed, centroids_owned=False)
+    prog = programs.compute("vct/inject_sum.glsl")
+    set_uniform(prog, "u_grid_size", tuple(int(n) for n in first.grid.size))
+    set_uniform(prog, "u_parts", len(parts))
+    padded = list(weights) + [np.zeros(3)] * (len(PARTS) - len(parts))
+    prog["u_weight"].value = [tuple(float(c) for c in w) for w in padded]
+    for i, texture in enumerate(out.textures):
+        bind_samplers(prog, "u_part", [faces.textures[i] for faces in parts], 0, pad_to=len(PARTS))
+        texture.bind_to_image(0, read=False, write=True)
+        dispatch(prog, first.grid.size)
+    ctx.memory_barrier()
+    return out
