@@ -1,6 +1,8 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """Grid sizes, bounce and iteration counts at their extremes: energy stays bounded (support/stress.check_sane's
 analytic bound), and a grid too large for the memory there is gives one clear message before any allocation."""
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -47,13 +49,15 @@ def test_a_grid_too_large_for_the_memory_is_one_clear_message(engine, monkeypatc
     render(engine, box_room(), method)
 
 
-@pytest.mark.parametrize("method, resolution", [("vct", 16), ("vct", 32), ("lpv", 12), ("lpv", 16)])
-def test_the_memory_estimate_covers_what_a_render_allocates(engine, monkeypatch, method, resolution):
+@pytest.mark.parametrize("method, resolution, sky", [("vct", 16, False), ("vct", 32, False), ("vct", 32, True),
+                                                    ("lpv", 12, False), ("lpv", 16, False)])
+def test_the_memory_estimate_covers_what_a_render_allocates(engine, monkeypatch, method, resolution, sky):
     """settings.method_bytes against the peak of the 3D textures and buffers a render holds at once (each counted
     from its creation to its release): at least all of it (the check must not let through what does not fit), at
     most 1.6× plus the fixed part (the VPL buffers, sized by the RSMs and clusters rather than the grid: up to twice
     the peak at 12³, where they are most of it). The peak, not the sum of every allocation: the LPV voxelises its
-    receivers once per axis, releasing each voxelisation's textures before the next (lpv/receivers.py)."""
+    receivers once per axis, releasing each voxelisation's textures before the next (lpv/receivers.py). With a sky
+    too, VCT injects the lamp and the sky apart and keeps both parts' faces (vct/parts.py)."""
     import moderngl
 
     live, peak = {}, [0]
@@ -84,7 +88,9 @@ def test_the_memory_estimate_covers_what_a_render_allocates(engine, monkeypatch,
     monkeypatch.setattr(moderngl.Context, "buffer", counted_buffer)
     for cls in (moderngl.Texture3D, moderngl.Buffer):
         monkeypatch.setattr(cls, "release", released(cls))
-    scene = box_room(1.0 + resolution * 1e-3)  # a scene of its own, so every pass runs and allocates
+    scene = box_room(1.0 + resolution * 1e-3 + 1e-4 * sky)  # a scene of its own, so every pass runs and allocates
+    if sky:
+        scene.world = replace(scene.world, color=(0.3, 0.3, 0.3))
     s = settings(method, resolution=resolution)
     engine.render(scene, s)
     monkeypatch.undo()
