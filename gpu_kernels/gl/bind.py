@@ -134,7 +134,7 @@ def ssbo(ctx, array: np.ndarray):
     return ctx.buffer(data if data else b"\0" * 16)
 
 
-ZERO_SLAB_BYTES = 32 * 2 ** 20  # the zero buffer's size at most: a larger volume is zeroed slab by slab
+ZERO_SLAB_BYTES = 32 * 2 ** 20  # a larger volume is zeroed in slabs of whole layers no larger (or of one layer)
 
 
 def zero_texture(ctx, texture) -> None:
@@ -144,7 +144,7 @@ def zero_texture(ctx, texture) -> None:
     Why not `texture.write(bytes(n))`: that builds the zeros in Python and copies them to the GPU every time —
     3.2 GB for the twelve 256³ RGBA32F face volumes of vct_inject, which took 4.6 s of the pass on an H200
     (benchmarks/results/h200). From a buffer object the copy stays on the device (and is faster on llvmpipe too;
-    and than a compute pass storing zeros: vct_inject's 50 MiB accumulator at 64³, 4 ms against 32–39 ms).
+    and than a compute pass storing zeros: vct_inject's 48 MiB accumulator at 64³, 4 ms against 32–39 ms).
     """
     depth = getattr(texture, "depth", 1)
     layer = texture.width * texture.height * texture.components * \

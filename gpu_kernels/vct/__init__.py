@@ -6,8 +6,8 @@ Passes (vct/passes.py runs them through the pass cache):
   vct_inject    surface points rasterised along their dominant axis and lit by every light exactly as the Diffuse
                 Direct pass lights pixels (direct/eval.glsl), averaged into six faces per voxel: the radiance
                 leaving through each face, its coverage and where its surfaces lie (vct/inject*.glsl); the lamps,
-                the emissive meshes and the sky each in a pass of its own where a scene has more than one of them,
-                summed, so an edit re-injects only its part (vct/parts.py);
+                the emissive meshes and the sky each in a pass of its own, summed, so an edit re-injects only its
+                part (vct/parts.py);
   vct_mipmap    the filtered radiance volumes: isotropic (mean of children) or anisotropic (six directions,
                 composited front to back, plus where each texel's surfaces lie along each axis, so a cone skips
                 surfaces behind where it started) (vct/mipmap.glsl, Freed 2018, §4.4);

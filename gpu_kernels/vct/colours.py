@@ -31,9 +31,10 @@ def largest_colour(colours: np.ndarray) -> np.ndarray:
     return np.where(largest > 0, largest, np.float32(1.0))
 
 
-def unit_records(shadows, scale: np.ndarray) -> np.ndarray:
-    """The light records with their colours divided by `scale` (what vct_inject lights the voxels with)."""
-    records = shadows.buffers.lights.copy()
+def unit_records(shadows, scale: np.ndarray, lights=None) -> np.ndarray:
+    """The light records (those at the indices `lights`, or all) with their colours divided by `scale` (what
+    vct_inject lights the voxels with)."""
+    records = (shadows.buffers.lights if lights is None else shadows.buffers.lights[lights]).copy()
     records["color_type"][:, :3] /= scale
     return records
 

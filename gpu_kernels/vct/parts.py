@@ -24,9 +24,9 @@ import numpy as np
 
 from ..common import lights as lb
 from ..common.emitters import emissive_triangles
-from ..gl.bind import bind_samplers, dispatch, set_uniform, texture3d
+from ..gl.bind import bind_named, dispatch, set_uniform, texture3d
 from ..scene import Scene, hash_parts
-from .colours import largest_colour
+from .colours import largest_colour, unit_records
 from .volumes import Faces
 
 PARTS = ("lamps", "emitters", "sky")  # the pass of each is vct_inject_<name>
@@ -74,15 +74,14 @@ def fits(grid, parts: int) -> bool:
 
 
 def parts_bytes(grid, parts: int) -> int:
-    """The memory the parts add on `grid`: the sum's face volumes, where there is more than one part and they fit."""
+    """The memory the parts add on `grid`: their face volumes (six a part), where there is more than one part and
+    they fit (one part is the injection itself)."""
     return parts * grid.voxel_count * FACE_BYTES if parts > 1 and fits(grid, parts) else 0
 
 
 def part_records(shadows, part: Part) -> np.ndarray:
     """The part's light records, their colours divided by its scale."""
-    records = shadows.buffers.lights[part.lights].copy()
-    records["color_type"][:, :3] /= part.scale
-    return records
+    return unit_records(shadows, part.scale, part.lights)
 
 
 def part_key(shadows, part: Part, records: np.ndarray) -> str:
@@ -104,10 +103,11 @@ def sum_parts(ctx, programs, parts: list, weights: list, centroids: list) -> Fac
     prog = programs.compute("vct/inject_sum.glsl")
     set_uniform(prog, "u_grid_size", tuple(int(n) for n in first.grid.size))
     set_uniform(prog, "u_parts", len(parts))
-    padded = list(weights) + [np.zeros(3)] * (len(PARTS) - len(parts))
-    prog["u_weight"].value = [tuple(float(c) for c in w) for w in padded]
+    for p, w in enumerate(list(weights) + [np.zeros(3)] * (len(PARTS) - len(parts))):
+        set_uniform(prog, f"u_weight{p}", tuple(float(c) for c in w))
     for i, texture in enumerate(out.textures):
-        bind_samplers(prog, "u_part", [faces.textures[i] for faces in parts], 0, pad_to=len(PARTS))
+        faces = [f.textures[i] for f in parts]
+        bind_named(prog, [(f"u_part{p}", faces[min(p, len(faces) - 1)]) for p in range(len(PARTS))])
         texture.bind_to_image(0, read=False, write=True)
         dispatch(prog, first.grid.size)
     ctx.memory_barrier()

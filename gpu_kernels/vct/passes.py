@@ -6,10 +6,11 @@
                       by the first that needs each part and kept across light, world and material colour edits
                       (volumes.VoxelGeometry)
     vct_inject_lamps, _emitters, _sky
-                    ← voxels, that part's lights' shadow maps and records per unit of its largest colour: where the
-                      lights make more than one part (vct/parts.py)
-    vct_inject      ← voxels, shadow maps, the lights per unit of the largest colour (vct/colours.py); or the parts
-                      and their weights, summed
+                    ← voxels, that part's lights' shadow maps and records per unit of its largest colour
+                      (vct/parts.py); every light at once in vct_inject instead where several parts' volumes would
+                      not fit
+    vct_inject      ← the parts and their weights, summed (one part: its faces, a view); or voxels, shadow maps and
+                      the lights per unit of the largest colour (vct/colours.py)
     vct_mipmap      ← injection, anisotropy
     vct_bounce      ← mipmaps, cone settings, bounces
     vct_specular    ← gbuffer, bounced volumes, specular settings

@@ -25,6 +25,9 @@ PASSES = ("Diffuse Indirect", "Combined")
 SAME = 1e-6
 
 
+TWO = ((60.0, (-0.5, 0.2, 1.5)), (30.0, (0.6, -0.3, 1.2)))  # two lamps: (power, place)
+
+
 def _room(lamps=((60.0, (-0.5, 0.2, 1.5)),), world=(0.05, 0.07, 0.1), emission=(4.0, 3.0, 2.0)):
     """An open-topped room (the sky comes in from above) with a block; `lamps`: (power, place) of point lights;
     the block's top is an emitter."""
@@ -75,9 +78,39 @@ def test_the_parts_sum_to_one_injection_of_every_light(monkeypatch):
         assert np.abs(a - b).max() <= SAME * np.abs(b).max()
         assert np.array_equal(a[:, 3], b[:, 3])  # the coverage is the geometry's
     _same(r, one)
+    flux, flux_one = r.info["bounces"][0]["flux"], one.info["bounces"][0]["flux"]  # the tail's and epsilon's input
+    assert np.allclose(flux, flux_one, rtol=SAME, atol=0.0), (flux, flux_one)
 
 
-TWO = ((60.0, (-0.5, 0.2, 1.5)), (30.0, (0.6, -0.3, 1.2)))
+def test_each_part_is_lit_by_its_own_records(monkeypatch):
+    """Each part's injection sees its lights alone: as many records in the buffer as its light count says."""
+    from bounce_gi.gpu_kernels.common.lights import LIGHT_DTYPE
+    from bounce_gi.gpu_kernels.vct import inject
+
+    seen, injected = [], inject.inject
+
+    def spy(ctx, programs, scene, geometry, textures, vox, shadows, *args):
+        seen.append((shadows.light_count, shadows.light_ssbo.size // LIGHT_DTYPE.itemsize))
+        return injected(ctx, programs, scene, geometry, textures, vox, shadows, *args)
+    monkeypatch.setattr(inject, "inject", spy)
+    Engine().render(_room(lamps=TWO), SETTINGS)
+    assert len(seen) == 3 and all(count == records for count, records in seen), seen
+    assert {count for count, _ in seen} >= {1, 2}, seen  # the sky; two lamps (and the emitter's clusters)
+
+
+def test_switching_between_parts_and_one_injection(monkeypatch):
+    """The same scene by parts, then (the cap lowered) all at once, then by parts again: the parts' passes dropped
+    and made again, the images the same within float rounding."""
+    engine = Engine()
+    by_parts = engine.render(_room(), SETTINGS)
+    monkeypatch.setattr(parts, "PART_BYTES_CAP", 0)
+    at_once = engine.render(_room(), SETTINGS)
+    assert not set(PARTS) & set(engine.pipeline.cache.entries) and "vct_inject" in _rerun(at_once)
+    monkeypatch.undo()
+    again = engine.render(_room(), SETTINGS)
+    assert set(PARTS) <= _rerun(again)
+    _same(at_once, by_parts)
+    _same(again, by_parts)
 
 
 @pytest.mark.parametrize("before,edit,kept", [

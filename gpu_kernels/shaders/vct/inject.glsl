@@ -17,9 +17,9 @@
 // Emission is not injected: emissive triangles are lights (common/lights.py), so E already carries their light,
 // and adding it again would count it twice (Cycles' Diffuse Indirect never holds emission). A closed emitter emits
 // outwards only (common/emitters.py): its inner light would leak out of the voxels.
-// The accumulator starts zeroed (gl/bind.zero_texture). MODE_RESOLVE writes the faces: rgb = L_g, a = α_g, and centroids: xyz = c_g,
-// w = α_g (or the face centre and w = −α_g for a fallback face; w = 0 where the voxel has no surface);
-// MODE_FALLBACK lights the fallback faces the resolve listed.
+// The accumulator starts zeroed (gl/bind.zero_texture). MODE_RESOLVE writes the faces: rgb = L_g, a = α_g, and
+// centroids: xyz = c_g, w = α_g (or the face centre and w = −α_g for a fallback face; w = 0 where the voxel has no
+// surface); MODE_FALLBACK lights the fallback faces the resolve listed.
 #if !defined(MODE_FALLBACK)
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;  // gl/bind.VOLUME_GROUP
 #endif
