@@ -11,7 +11,7 @@ from ..common import lights as lb
 from ..gl.bind import bind_lights, bind_samplers, dispatch, read_texture, set_uniform, set_uniforms, ssbo
 from ..scene import hash_parts
 from .gbuffer import GBuffer
-from .shadows import ShadowAtlas
+from .shadows import ShadowAtlas, emitter_records
 
 
 MAX_UNIT_GROUPS = 16  # lights lit alone per unit of their colour (each keeps two images); the rest share a group
@@ -46,8 +46,7 @@ def light_groups(shadows: ShadowAtlas) -> list[LightGroup]:
     MAX_UNIT_GROUPS. Keys from shadows.light_keys (a light's record without its colour and its packed views)."""
     records = shadows.buffers.lights
     alone, shared = [], []
-    for i, rec in enumerate(records):
-        emitter = int(rec["color_type"][3]) == lb.LIGHT_POLYGON and rec["polygon"][3] > 0.5  # a triangle list
+    for i, emitter in enumerate(emitter_records(records)):
         (shared if emitter or len(alone) >= MAX_UNIT_GROUPS else alone).append(i)
     groups = [LightGroup(shadows.light_keys[i], [i], True) for i in alone]
     if shared:

@@ -15,6 +15,12 @@ from ..scene import Scene, hash_parts
 from .geometry import GeometryBuffers
 
 
+def emitter_records(lights: np.ndarray) -> np.ndarray:
+    """Which of the light records (common/lights.LIGHT_DTYPE) are an emissive mesh's clusters: polygon lights whose
+    polygon is a triangle list (polygon.w = 1, lights.triangle_list_vertices), not an area light's outline."""
+    return (lights["color_type"][:, 3] == lb.LIGHT_POLYGON) & (lights["polygon"][:, 3] > 0.5)
+
+
 @dataclass
 class ShadowAtlas:
     depth: object  # depth texture with comparison enabled
@@ -37,9 +43,7 @@ class ShadowAtlas:
     def defines(self) -> dict:
         """Defines for a program that evaluates these lights (common/light_eval.glsl): NO_TRIANGLE_LISTS where none
         is an emitter's triangle list (the scene has no emissive mesh), which leaves that code out of the program."""
-        lights = self.buffers.lights
-        lists = (lights["color_type"][:, 3] == lb.LIGHT_POLYGON) & (lights["polygon"][:, 3] > 0.5)
-        return {} if np.any(lists) else {"NO_TRIANGLE_LISTS": None}
+        return {} if np.any(emitter_records(self.buffers.lights)) else {"NO_TRIANGLE_LISTS": None}
 
     def raw_depth(self):
         """A sampler reading `depth`'s values without comparison, nearest (made on first use)."""

@@ -23,10 +23,10 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..common import lights as lb
-from ..common.emitters import emissive_triangles
+from ..direct.shadows import emitter_records
 from ..gl.bind import bind_named, dispatch, set_uniform, texture3d
 from ..scene import Scene, hash_parts
-from .colours import largest_colour, unit_records
+from .colours import largest_colour
 from .volumes import Faces
 
 PARTS = ("lamps", "emitters", "sky")  # the pass of each is vct_inject_<name>
@@ -37,7 +37,7 @@ FACE_BYTES = 6 * 16  # six RGBA32F face volumes a voxel
 @dataclass
 class Part:
     """A group of light records injected together: `lights` their indices, `scale` (3,) their largest colour per
-    channel (1 where none has any), by which the records it injects are divided."""
+    channel (1 where none has any), by which the records it injects are divided (colours.unit_records)."""
     name: str
     lights: np.ndarray
     scale: np.ndarray
@@ -47,9 +47,8 @@ def light_parts(shadows) -> list[Part]:
     """The non-empty parts of the shadows' light records, in PARTS order: the sky light(s), the emissive meshes'
     clusters (triangle lists), and every other light (the lamps)."""
     records = shadows.buffers.lights
-    kinds = records["color_type"][:, 3].astype(int)
-    emitter = (kinds == lb.LIGHT_POLYGON) & (records["polygon"][:, 3] > 0.5)
-    sky = kinds == lb.LIGHT_SKY
+    emitter = emitter_records(records)
+    sky = records["color_type"][:, 3].astype(int) == lb.LIGHT_SKY
     masks = {"lamps": ~emitter & ~sky, "emitters": emitter, "sky": sky}
     out = []
     for name in PARTS:
@@ -62,7 +61,7 @@ def light_parts(shadows) -> list[Part]:
 def scene_parts(scene: Scene) -> int:
     """How many parts `scene`'s lights make (settings.method_bytes: before any light record exists)."""
     lamps = any(light.power > 0 for light in scene.lights)
-    emitters = len(emissive_triangles(scene)[0]) > 0
+    emitters = scene.has_emission()
     sky = max(np.asarray(scene.world.color, np.float64)[:3], default=0.0) > 0
     return int(lamps) + int(emitters) + int(sky)
 
@@ -77,11 +76,6 @@ def parts_bytes(grid, parts: int) -> int:
     """The memory the parts add on `grid`: their face volumes (six a part), where there is more than one part and
     they fit (one part is the injection itself)."""
     return parts * grid.voxel_count * FACE_BYTES if parts > 1 and fits(grid, parts) else 0
-
-
-def part_records(shadows, part: Part) -> np.ndarray:
-    """The part's light records, their colours divided by its scale."""
-    return unit_records(shadows, part.scale, part.lights)
 
 
 def part_key(shadows, part: Part, records: np.ndarray) -> str:

@@ -49,10 +49,9 @@ def run(frame) -> MethodOutput:
     # The lights per unit of the largest colour (vct/colours.py): an edit scaling every light alike keeps all that
     # follows, and only the results are scaled back.
     scale = colours.colour_scale(frame.shadows)
-    records = colours.unit_records(frame.shadows, scale)
     shared = cache.run("vct_geometry", (frame.keys["geometry"], frame.keys["emission"], grid.key(), levels),
                        VoxelGeometry)
-    faces, k_inject = _inject(frame, vox, shared, (k_vox, levels), scale, records)
+    faces, k_inject = _inject(frame, vox, shared, (k_vox, levels), scale)
     k_mip = (k_inject, s.anisotropic)
     volumes = cache.run("vct_mipmap", k_mip, lambda: mipmap.build_volumes(ctx, programs, faces, s.anisotropic,
                                                                          shared=shared))
@@ -74,11 +73,11 @@ def run(frame) -> MethodOutput:
     return MethodOutput(*out, key, colours.scale_info(info, scale), has_ao=True)
 
 
-def _inject(frame, vox, shared, base: tuple, scale: np.ndarray, records: np.ndarray) -> tuple:
+def _inject(frame, vox, shared, base: tuple, scale: np.ndarray) -> tuple:
     """vct_inject: each part of the lights (the lamps, the emissive meshes, the sky) injected in its own pass per unit
     of its colour and summed with weights (vct/parts.py; one part is taken as it is), or, where the parts' volumes
-    would not fit, every light at once. `base` = (the voxels' key, levels); `records` the lights per unit of
-    `scale`. Returns the faces and their key."""
+    would not fit, every light at once per unit of `scale`. `base` = (the voxels' key, levels). Returns the faces
+    and their key."""
     ctx, programs, cache, shadows = frame.ctx, frame.programs, frame.cache, frame.shadows
     k_vox, levels = base
     scratch = {}  # the accumulator and front-most surfaces, shared by the parts injected in this frame
@@ -91,11 +90,12 @@ def _inject(frame, vox, shared, base: tuple, scale: np.ndarray, records: np.ndar
     try:
         if not light_parts or not parts.fits(vox.grid, len(light_parts)):
             cache.drop([f"vct_inject_{name}" for name in parts.PARTS])
+            records = colours.unit_records(shadows, scale)
             k_inject = (k_vox, colours.unit_key(shadows, records), levels)
             return cache.run("vct_inject", k_inject, lambda: injected(records)), k_inject
         made, keys = [], []
         for part in light_parts:
-            subset = parts.part_records(shadows, part)
+            subset = colours.unit_records(shadows, part.scale, part.lights)
             key = (k_vox, parts.part_key(shadows, part, subset), levels)
             made.append(cache.run(f"vct_inject_{part.name}", key, lambda subset=subset: injected(subset)))
             keys.append(key)
