@@ -64,6 +64,9 @@ def bounce(ctx, programs, vox, direct_faces: Faces, volumes: ConeVolumes, s: Vct
 
 
 FACES_PER_DISPATCH = 65535 * 64  # work groups of 64 (vct/bounce.glsl), at most 65535 a dispatch
+# Entries of the face list reordered together after the record (order_by_steps): measured on the Cornell box, the
+# replays took about as long with runs of 64 to 4096 entries, a third longer sorted over the whole list.
+ORDER_BLOCK = 256
 
 
 def face_list(ctx, programs, faces: Faces, capacity: int | None = None) -> tuple:
@@ -120,6 +123,7 @@ def gather_pool(ctx, shared: VoxelGeometry, count: int, s: VctSettings) -> repla
 def gather_listed(ctx, prog, listed, count: int, pool: replay.HitPool | None = None) -> None:
     """vct/bounce.glsl over the `count` faces of `listed` (face_list), one per invocation; with a `pool`, recorded
     into it (and marked recorded) or replayed from it."""
+    recording = pool is not None and not pool.recorded
     listed.bind_to_storage_buffer(5)
     set_uniform(prog, "u_face_count", count)
     with replay.pooled(ctx, prog, pool):
@@ -127,6 +131,22 @@ def gather_listed(ctx, prog, listed, count: int, pool: replay.HitPool | None = N
             set_uniform(prog, "u_face_first", first)
             dispatch(prog, (min(FACES_PER_DISPATCH, count - first),), 64)
         ctx.memory_barrier()
+    if recording:
+        order_by_steps(listed, pool, count)
+
+
+def order_by_steps(listed, pool: replay.HitPool, count: int) -> None:
+    """The face list and the pool's headers (one per list entry) reordered within each run of ORDER_BLOCK entries,
+    most recorded steps first. A replay loops over a face's steps, and SIMD lanes run as many iterations as their
+    longest face: in the list's order (by face direction, then voxel) the lanes of a group of 8 ran 1.4× the steps
+    they replayed, 1.55× in groups of 16 (the Cornell box and window_room). Sorted over the whole list, a group's
+    faces lay all over the grid and the replays got slower; within runs, they stay near each other. Each face's
+    result is its own, so the order changes no value."""
+    headers = np.frombuffer(pool.headers.read(size=16 * count), np.uint32).reshape(count, 4)
+    entries = np.frombuffer(listed.read(size=16 * count), np.int32).reshape(count, 4)
+    order = np.lexsort((-headers[:, 1].astype(np.int64), np.arange(count) // ORDER_BLOCK))
+    pool.headers.write(np.ascontiguousarray(headers[order]).tobytes())
+    listed.write(np.ascontiguousarray(entries[order]).tobytes())
 
 
 def _total(stat: dict) -> float:

@@ -73,3 +73,28 @@ def test_a_black_surface_made_bright_is_gathered_anew(monkeypatch):
             assert np.array_equal(replayed.passes[name], plain.passes[name]), name
     finally:
         engine.shutdown()
+
+
+def test_the_record_orders_each_run_of_faces_by_its_steps(monkeypatch):
+    """After the record, the face list and the pool's headers are permuted alike (bounce.order_by_steps): within each
+    run of ORDER_BLOCK entries the faces with the most recorded steps come first, and the list still holds every
+    face with coverage once (the replays equal plain gathers: test_replayed_gathers_are_the_gathers)."""
+    monkeypatch.setattr(bounce, "ORDER_BLOCK", 64)
+    engine = Engine()
+    try:
+        engine.render(_room(), SETTINGS)
+        shared = engine.pipeline.cache.entries["vct_geometry"].value
+        listed, count = shared.face_list
+
+        def read():
+            steps = np.frombuffer(shared.gather_pool.headers.read(size=16 * count), np.uint32).reshape(count, 4)[:, 1]
+            return steps.astype(np.int64), np.frombuffer(listed.read(size=16 * count), np.int32).reshape(count, 4)
+
+        steps, entries = engine.worker.call(lambda ctx: read())
+        assert count > 4 * 64 and len(np.unique(steps)) > 10
+        runs = steps[: count // 64 * 64].reshape(-1, 64)
+        assert (np.diff(runs, axis=1) <= 0).all()
+        assert not (np.diff(steps) <= 0).all()  # runs, not one sort over the whole list
+        assert len({tuple(e) for e in entries}) == count
+    finally:
+        engine.shutdown()

@@ -55,9 +55,14 @@ vec3 gather_replay(uvec4 header) {
         uint tag = floatBitsToUint(st.alpha_t_tag.z);
         end_cones(e, radiance, cone, int(tag & 31u));
         uint sides = tag >> 5;
-        vec4 sx = volume_at(sides & 1u, st.uvw_lod.xyz, st.uvw_lod.w);
-        vec4 sy = volume_at(2u + ((sides >> 1) & 1u), st.uvw_lod.xyz, st.uvw_lod.w);
-        vec4 sz = volume_at(4u + ((sides >> 2) & 1u), st.uvw_lod.xyz, st.uvw_lod.w);
+        // Each axis's volume picked from its two by name, not through volume_at's six-way switch: llvmpipe runs
+        // every case of a switch its lanes disagree on, so that read six textures for each one used (measured:
+        // the replays took twice as long).
+        vec3 q = st.uvw_lod.xyz;
+        float lod = st.uvw_lod.w;
+        vec4 sx = (sides & 1u) == 0u ? textureLod(u_replay0, q, lod) : textureLod(u_replay1, q, lod);
+        vec4 sy = (sides & 2u) == 0u ? textureLod(u_replay2, q, lod) : textureLod(u_replay3, q, lod);
+        vec4 sz = (sides & 4u) == 0u ? textureLod(u_replay4, q, lod) : textureLod(u_replay5, q, lod);
         vec3 w = st.w_tau.xyz;
         float tau = st.w_tau.w;
         vec3 step_radiance = (w.x * sx.rgb + w.y * sy.rgb + w.z * sz.rgb) / tau;

@@ -182,37 +182,45 @@ vec4 premultiplied(vec4 t) {
     return t.a > 0.0 ? vec4(alpha * t.rgb / t.a, alpha) : vec4(0.0);
 }
 
+#if defined(MODE_ANISO)
+// One parent face f from its children. Called with f a constant for each face, not from a loop over f: llvmpipe
+// runs every case of src_face's and store_dst's switches for an index it cannot fold (measured: the re-mips
+// after each bounce took N times as long).
+void down_face(int f, ivec3 v, ivec3 base) {
+    int axis = f >> 1;
+    ivec3 step = ivec3(0);
+    step[axis] = 1;
+    // Travelling +axis, the child with the lower coordinate is in front; travelling −axis, the higher one.
+    bool forward = (f & 1) == 0;
+    vec4 sum = vec4(0.0);   // premultiplied (α·S, α), composited per column
+    for (int j = 0; j < 2; ++j)
+        for (int i = 0; i < 2; ++i) {
+            ivec3 c = base;
+            int u = (axis + 1) % 3, w = (axis + 2) % 3;
+            c[u] += i;
+            c[w] += j;
+            vec4 lo = premultiplied(child(f, c)), hi = premultiplied(child(f, c + step));
+            vec4 front = forward ? lo : hi, back = forward ? hi : lo;
+            sum += front + (1.0 - front.a) * back;
+        }
+    // The mean over the columns of α (the fraction of rays crossing the parent along f that are stopped), not
+    // of τ: averaging τ enlarges a small bright object to the whole parent (Cornell's box tops, 6.5 W/(m²·sr),
+    // took over their coarse texels: Cornell / courtyard Diffuse Indirect came out 15% / 8% brighter at 8
+    // bounces, measured), at the price of some light through corners, where a coarse texel is half outside a
+    // room (white furnace 5% low).
+    sum *= 0.25;
+    float tau = depth_of(sum.a);
+    store_dst(f, v, sum.a > 0.0 ? vec4(tau * sum.rgb / sum.a, tau) : vec4(0.0));
+}
+#endif
+
 void main() {
     ivec3 v = ivec3(gl_GlobalInvocationID);
     if (any(greaterThanEqual(v, u_dst_size))) return;
     ivec3 base = 2 * v;
 #if defined(MODE_ANISO)
-    for (int f = 0; f < 6; ++f) {
-        int axis = f >> 1;
-        ivec3 step = ivec3(0);
-        step[axis] = 1;
-        // Travelling +axis, the child with the lower coordinate is in front; travelling −axis, the higher one.
-        bool forward = (f & 1) == 0;
-        vec4 sum = vec4(0.0);   // premultiplied (α·S, α), composited per column
-        for (int j = 0; j < 2; ++j)
-            for (int i = 0; i < 2; ++i) {
-                ivec3 c = base;
-                int u = (axis + 1) % 3, w = (axis + 2) % 3;
-                c[u] += i;
-                c[w] += j;
-                vec4 lo = premultiplied(child(f, c)), hi = premultiplied(child(f, c + step));
-                vec4 front = forward ? lo : hi, back = forward ? hi : lo;
-                sum += front + (1.0 - front.a) * back;
-            }
-        // The mean over the columns of α (the fraction of rays crossing the parent along f that are stopped), not
-        // of τ: averaging τ enlarges a small bright object to the whole parent (Cornell's box tops, 6.5 W/(m²·sr),
-        // took over their coarse texels: Cornell / courtyard Diffuse Indirect came out 15% / 8% brighter at 8
-        // bounces, measured), at the price of some light through corners, where a coarse texel is half outside a
-        // room (white furnace 5% low).
-        sum *= 0.25;
-        float tau = depth_of(sum.a);
-        store_dst(f, v, sum.a > 0.0 ? vec4(tau * sum.rgb / sum.a, tau) : vec4(0.0));
-    }
+    down_face(0, v, base); down_face(1, v, base); down_face(2, v, base);
+    down_face(3, v, base); down_face(4, v, base); down_face(5, v, base);
 #else
     vec4 sum = vec4(0.0);
     for (int k = 0; k < 8; ++k) sum += child(0, base + ivec3(k & 1, (k >> 1) & 1, k >> 2));
