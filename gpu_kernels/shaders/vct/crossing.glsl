@@ -139,6 +139,11 @@ ConeResult trace_cone_crossing(vec3 o, vec3 d, float tan_half) {
         }
         float hit_lod = max(lod - 1.0, 0.0);
         float hit_texel = exp2(hit_lod);
+        // The crossings are found first and read after: one bit per sub-ray j and texel n (bit 9j + n, the order
+        // they are taken in, as the loops over j, a, k found them). llvmpipe runs a loop's body for every SIMD lane
+        // whenever one lane needs it, so reading while searching read two textures for each of the SUBRAYS × 9
+        // candidates at every step (as vct/arrays.glsl's switches); only crossings are read now.
+        uvec2 crossed = uvec2(0u);
         for (int j = 0; j < ns && any_surface; ++j) {   // in empty space there is nothing to cross
             if (T[j] < MIN_TRANSMITTANCE) continue;
             vec3 m = gb[j] - ga[j];
@@ -154,26 +159,40 @@ ConeResult trace_cone_crossing(vec3 o, vec3 d, float tan_half) {
                     if (fa <= 0.0 || fb > 0.0) continue;
                     vec3 hit = ga[j] + m * (fa / (fa - fb));
                     if (any(lessThan(hit, vec3(0.0))) || any(greaterThan(hit, size))) continue;   // beyond the grid
-                    // What the sub-ray meets is read one level finer than the cone, in its own column, over the
-                    // whole depth of the crossed texel (its two finer texels along a, front first): a tilted
-                    // surface lies in either of them there, wherever the texel's mean depth put the crossing.
-                    float idx = floor(hit[a] / texel);
-                    int parts = lod > 0.0 ? 2 : 1;
-                    for (int h = 0; h < parts; ++h) {
-                        float fine = parts == 1 ? idx : 2.0 * idx + float(m[a] > 0.0 ? h : 1 - h);
-                        vec3 q = hit;
-                        q[a] = (fine + 0.5) * hit_texel;
-                        q *= inv_size;
-                        vec4 s = m[a] > 0.0 ? textureLod(u_volume[2 * a], q, hit_lod)
-                                            : textureLod(u_volume[2 * a + 1], q, hit_lod);
-                        if (s.a <= 0.0) continue;
-                        float alpha = min(1.0 - exp(-s.a), T[j]);
-                        r.radiance += inv_ns * alpha * s.rgb / s.a;   // vct/hits.glsl replays this term
+                    int bit = 9 * j + n;
+                    if (bit < 32) crossed.x |= 1u << bit;
+                    else crossed.y |= 1u << (bit - 32);
+                }
+            }
+        }
+        for (int word = 0; word < 2; ++word) {
+            uint bits = word == 0 ? crossed.x : crossed.y;
+            while (bits != 0u) {
+                int bit = 32 * word + findLSB(bits);
+                bits &= bits - 1u;
+                int j = bit / 9, n = bit - 9 * (bit / 9), a = n / 3;
+                vec3 m = gb[j] - ga[j];
+                float fa = (wa[n] - ga[j][a]) * sign(m[a]), fb = (wb[n] - gb[j][a]) * sign(m[a]);
+                vec3 hit = ga[j] + m * (fa / (fa - fb));
+                // What the sub-ray meets is read one level finer than the cone, in its own column, over the
+                // whole depth of the crossed texel (its two finer texels along a, front first): a tilted
+                // surface lies in either of them there, wherever the texel's mean depth put the crossing.
+                float idx = floor(hit[a] / texel);
+                int parts = lod > 0.0 ? 2 : 1;
+                for (int h = 0; h < parts; ++h) {
+                    float fine = parts == 1 ? idx : 2.0 * idx + float(m[a] > 0.0 ? h : 1 - h);
+                    vec3 q = hit;
+                    q[a] = (fine + 0.5) * hit_texel;
+                    q *= inv_size;
+                    vec4 s = m[a] > 0.0 ? textureLod(u_volume[2 * a], q, hit_lod)
+                                        : textureLod(u_volume[2 * a + 1], q, hit_lod);
+                    if (s.a <= 0.0) continue;
+                    float alpha = min(1.0 - exp(-s.a), T[j]);
+                    r.radiance += inv_ns * alpha * s.rgb / s.a;   // vct/hits.glsl replays this term
 #if defined(MODE_RECORD)
-                        record_hit(q, hit_lod, m[a] > 0.0 ? 2 * a : 2 * a + 1, alpha);
+                    record_hit(q, hit_lod, m[a] > 0.0 ? 2 * a : 2 * a + 1, alpha);
 #endif
-                        T[j] -= alpha;
-                    }
+                    T[j] -= alpha;
                 }
             }
         }
