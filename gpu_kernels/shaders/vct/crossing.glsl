@@ -120,6 +120,7 @@ ConeResult trace_cone_crossing(vec3 o, vec3 d, float tan_half) {
         // Voxel units; −1: no surface (surfaces lie at ≥ 1: the grid has an empty margin voxel).
         float wa[9], wb[9];
         bool any_surface = false;
+        uint reached = 0u;   // the texels some sub-ray's path reaches, read below (as the crossings: see there)
         for (int a = 0; a < 3; ++a) {
             float mid = floor(g[a] / texel);
             for (int k = 0; k < 3; ++k) {
@@ -130,12 +131,19 @@ ConeResult trace_cone_crossing(vec3 o, vec3 d, float tan_half) {
                 // Outside the grid there is nothing (no clamped copies of the border texels).
                 if (idx < 0.0 || idx >= size[a] / texel || (idx + 1.0) * texel < lo[a] || idx * texel > hi[a])
                     continue;
-                wa[n] = surface_along(uvw_a, a, idx, texel, lod);
-                wb[n] = surface_along(uvw_b, a, idx, texel, lod);
-                if (wa[n] < 0.0) wa[n] = wb[n];
-                if (wb[n] < 0.0) wb[n] = wa[n];
-                any_surface = any_surface || wa[n] >= 0.0;
+                reached |= 1u << n;
             }
+        }
+        while (reached != 0u) {
+            int n = findLSB(reached);
+            reached &= reached - 1u;
+            int a = n / 3;
+            float idx = floor(g[a] / texel) - 1.0 + float(n - 3 * a);
+            wa[n] = surface_along(uvw_a, a, idx, texel, lod);
+            wb[n] = surface_along(uvw_b, a, idx, texel, lod);
+            if (wa[n] < 0.0) wa[n] = wb[n];
+            if (wb[n] < 0.0) wb[n] = wa[n];
+            any_surface = any_surface || wa[n] >= 0.0;
         }
         float hit_lod = max(lod - 1.0, 0.0);
         float hit_texel = exp2(hit_lod);
