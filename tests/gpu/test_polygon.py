@@ -108,3 +108,60 @@ def test_split_octagon_projected_solid_angles_match_clipping_then_lambert(tmp_pa
     assert kinds == {(True, False), (False, True), (True, True)}  # whole above, whole below, split: all met
     # float32 arithmetic over eight edges' atan terms: a few 1e-5 relative (2e-4 allowed); atol for slivers
     np.testing.assert_allclose(ours, exact, rtol=2e-4, atol=2e-6)
+
+
+TRIANGLE_PROBE = """
+#version 430 core
+#include "common/polygon.glsl"
+layout(local_size_x = 1) in;
+layout(std430, binding = 0) readonly buffer Triangles { vec4 corners[]; };  // per case: 3 corners, the point, n
+layout(std430, binding = 1) writeonly buffer Out { vec4 out_v[]; };
+void main() {
+    int i = int(gl_GlobalInvocationID.x);
+    vec3 p = corners[5 * i + 3].xyz, n = corners[5 * i + 4].xyz;
+    vec3 a = corners[5 * i].xyz - p, b = corners[5 * i + 1].xyz - p, c = corners[5 * i + 2].xyz - p;
+    out_v[i] = vec4(triangle_projected_solid_angles(a, b, c, n),
+                    triangle_projected_solid_angle(a, b, c, n), triangle_projected_solid_angle(a, b, c, -n));
+}
+"""
+
+
+def test_triangle_projected_solid_angles_are_both_sides_of_one_triangle(tmp_path):
+    """triangle_projected_solid_angles (VCT's injection lights both sides of a surface point with it) against the
+    clip-then-Lambert reference for n and −n, and against two calls of the one-sided triangle_projected_solid_angle:
+    triangles whole above, whole below and cut by the receiver's plane."""
+    moderngl = pytest.importorskip("moderngl")
+    from bounce_gi.gpu_kernels.gl import preprocessor as spp
+
+    try:
+        ctx = moderngl.create_standalone_context(backend="egl", require=430)
+    except Exception as exc:  # no EGL / GL 4.3 here
+        pytest.skip(f"no OpenGL 4.3 context: {exc}")
+    count = 256
+    octagons, probes = _cases(np.random.default_rng(7), count)
+    cases = np.zeros((count, 5, 4), np.float32)
+    cases[:, :3, :3] = octagons[:, [0, 3, 5]]  # three of a convex octagon's corners: a triangle in its plane
+    cases[:, 3, :3] = [p for p, _ in probes]
+    cases[:, 4, :3] = [n for _, n in probes]
+    src = tmp_path / "triangle.glsl"
+    src.write_text(TRIANGLE_PROBE)
+    prog = ctx.compute_shader(spp.preprocess(src, search_dirs=[spp.SHADER_DIR]).text)
+    bufs = [ctx.buffer(cases.tobytes()), ctx.buffer(reserve=count * 16)]
+    for i, b in enumerate(bufs):
+        b.bind_to_storage_buffer(i)
+    prog.run(count, 1, 1)
+    ours = np.frombuffer(bufs[1].read(), np.float32).reshape(count, 4).astype(np.float64)
+    for b in bufs:
+        b.release()
+    prog.release()
+    ctx.release()
+    exact, kinds = np.zeros((count, 2)), set()
+    for i, case in enumerate(cases[..., :3].astype(np.float64)):
+        q, n = case[:3] - case[3], case[4]
+        above, below = _clip(q, n), _clip(q, -n)
+        exact[i] = (_lambert(above, n) if len(above) >= 3 else 0.0, _lambert(below, -n) if len(below) >= 3 else 0.0)
+        kinds.add((len(above) >= 3, len(below) >= 3))
+    assert kinds == {(True, False), (False, True), (True, True)}
+    # float32 over three edges' atan terms (as the octagons' test); the two functions take the same terms
+    np.testing.assert_allclose(ours[:, :2], exact, rtol=2e-4, atol=2e-6)
+    np.testing.assert_allclose(ours[:, :2], ours[:, 2:], rtol=1e-5, atol=1e-7)

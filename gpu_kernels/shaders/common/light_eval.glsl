@@ -117,3 +117,34 @@ vec3 polygon_light_solid_angle(GpuLight L, vec3 p, vec3 n) {
 #endif
 }
 
+// polygon_light_solid_angle for n (returned) and −n (`back`) at once: a triangle list's triangles are evaluated once
+// for both sides (triangle_projected_solid_angles), a single polygon twice.
+vec3 polygon_light_solid_angles(GpuLight L, vec3 p, vec3 n, out vec3 back) {
+    int first = int(L.polygon.x), count = int(L.polygon.y);
+#if !defined(NO_TRIANGLE_LISTS)
+    if (L.polygon.w >= 0.5) {
+        vec3 front = vec3(0.0);
+        back = vec3(0.0);
+        for (int i = first; i < first + count; i += 4) {
+            vec3 a = polygon_vertices[i].xyz - p, b = polygon_vertices[i + 1].xyz - p;
+            vec3 c = polygon_vertices[i + 2].xyz - p;
+            vec4 scale = polygon_vertices[i + 3];
+            vec3 tn = cross(b - a, c - a);
+            float len = length(tn);
+            float height = -dot(a, tn) / max(len, 1e-30);
+            if (scale.w > 0.5 && height < 0.0) continue;   // as polygon_light_solid_angle
+            if (abs(height) <= SELF_PLANE * sqrt(0.5 * len)) {
+                vec3 edges = vec3(dot(cross(b - a, -a), tn), dot(cross(c - b, -b), tn), dot(cross(a - c, -c), tn));
+                if (min(edges.x, min(edges.y, edges.z)) > 1e-3 * len * len) continue;
+            }
+            vec2 both = triangle_projected_solid_angles(a, b, c, n);
+            front += both.x * scale.rgb;
+            back += both.y * scale.rgb;
+        }
+        return front;
+    }
+#endif
+    back = vec3(polygon_projected_solid_angle(first, count, p, -n));
+    return vec3(polygon_projected_solid_angle(first, count, p, n));
+}
+

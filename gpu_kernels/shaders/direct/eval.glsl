@@ -304,6 +304,20 @@ vec3 light_unshadowed(GpuLight L, vec3 p, vec3 n) {
     return color * polygon_light_solid_angle(L, p, n);
 }
 
+// light_unshadowed for n (returned) and −n (`back`): both sides of a surface point, as VCT's injection lights them;
+// an emissive mesh's triangles are evaluated once for the two.
+vec3 light_unshadowed_sides(GpuLight L, vec3 p, vec3 n, out vec3 back) {
+    if (int(L.color_type.w) == LIGHT_POLYGON) {
+        back = vec3(0.0);
+        if (L.polygon.z < 0.5 && dot(p - L.position.xyz, L.direction.xyz) <= 0.0) return vec3(0.0);
+        vec3 front = L.color_type.rgb * polygon_light_solid_angles(L, p, n, back);
+        back *= L.color_type.rgb;
+        return front;
+    }
+    back = light_unshadowed(L, p, -n);
+    return light_unshadowed(L, p, n);
+}
+
 // The light's shadow-map visibility at p (1 for lights that cast no shadow).
 float light_visibility(GpuLight L, vec3 p, vec3 n, vec3 geo_n) {
     if (L.params.z <= 0.0) return 1.0;

@@ -140,12 +140,20 @@ void main() {
 #endif
     vec3 color = u_use_texture ? textureLod(u_base_texture, g_uv, 0.0).rgb : u_base_color;
     vec3 albedo = max(color, vec3(0.0)) * u_albedo_scale + u_albedo_offset;
+    // Both sides lit in one pass over the lights (light_unshadowed_sides: an emissive mesh's triangles once for the
+    // two), each side's irradiance summed over the lights in their order as light_irradiance would.
+    vec3 lit[2] = vec3[2](vec3(0.0), vec3(0.0));
+    if (max(albedo.r, max(albedo.g, albedo.b)) > 0.0)
+        for (int i = 0; i < u_light_count; ++i) {
+            vec3 back, front = light_unshadowed_sides(lights[i], p, g_normal, back);
+            if (max(front.r, max(front.g, front.b)) > 0.0)
+                lit[0] += front * light_visibility(lights[i], p, g_normal, g_normal);
+            if (max(back.r, max(back.g, back.b)) > 0.0)
+                lit[1] += back * light_visibility(lights[i], p, -g_normal, -g_normal);
+        }
     for (int side = 0; side < 2; ++side) {
         vec3 n = side == 0 ? g_normal : -g_normal;
-        vec3 e = vec3(0.0);
-        if (max(albedo.r, max(albedo.g, albedo.b)) > 0.0)
-            for (int i = 0; i < u_light_count; ++i) e += light_irradiance(lights[i], p, n, n);
-        vec3 radiance = albedo * e / PI;
+        vec3 radiance = albedo * lit[side] / PI;
         for (int b = 0; b < 3; ++b) {
             float w = g_area * abs(n[b]);
             if (w <= 0.0) continue;
