@@ -19,25 +19,31 @@ vec3 cut(vec3 a, vec3 b, float ha, float hb) {  // where edge a→b crosses the 
     return a + (b - a) * (ha / (ha - hb));
 }
 
-// The part of edge a→b above the plane (heights ha, hb), appended to q (one Sutherland–Hodgman step).
-void clip_edge(vec3 a, vec3 b, float ha, float hb, inout vec3 q[4], inout int m) {
-    if (ha >= 0.0 && m < 4) q[m++] = a;
-    if ((ha >= 0.0) != (hb >= 0.0) && m < 4) q[m++] = cut(a, b, ha, hb);
+// The piece of edge a→b above the plane (heights ha, hb; ua, ub its unit directions): its Lambert term, and where
+// it leaves or enters the side above. One term an edge, its ends chosen first (llvmpipe runs both sides of a branch).
+float above_unit_edge(vec3 a, vec3 b, vec3 ua, vec3 ub, float ha, float hb, vec3 n, inout vec3 enter,
+                      inout vec3 leave) {
+    bool crosses = (ha >= 0.0) != (hb >= 0.0);
+    vec3 cp = crosses ? cut(a, b, ha, hb) : b;
+    vec3 ucp = crosses ? normalize(cp) : ub;
+    if (crosses && ha >= 0.0) leave = cp;
+    if (crosses && ha < 0.0) enter = cp;
+    float term = unit_lambert_edge(ha >= 0.0 ? ua : ucp, ha >= 0.0 ? ucp : ub, n);
+    return ha >= 0.0 || crosses ? term : 0.0;
 }
 
 // polygon_projected_solid_angle of one triangle (vertices relative to the receiver), without loops: an emitter
-// cluster holds many, and llvmpipe caps a shader invocation's loop iterations (docs/conventions.md).
+// cluster holds many, and llvmpipe caps a shader invocation's loop iterations (docs/conventions.md). The part above
+// the receiver's plane: each edge's piece above it, closed along the plane from where it leaves to where it enters.
 float triangle_projected_solid_angle(vec3 a, vec3 b, vec3 c, vec3 n) {
     float ha = dot(a, n), hb = dot(b, n), hc = dot(c, n);
     if (max(ha, max(hb, hc)) <= 1e-5 * max(length(a), max(length(b), length(c)))) return 0.0;
-    vec3 q[4];
-    int m = 0;
-    clip_edge(a, b, ha, hb, q, m);
-    clip_edge(b, c, hb, hc, q, m);
-    clip_edge(c, a, hc, ha, q, m);
-    if (m < 3) return 0.0;
-    float sum = lambert_edge(q[0], q[1], n) + lambert_edge(q[1], q[2], n);
-    sum += m == 4 ? lambert_edge(q[2], q[3], n) + lambert_edge(q[3], q[0], n) : lambert_edge(q[2], q[0], n);
+    vec3 ua = normalize(a), ub = normalize(b), uc = normalize(c);
+    vec3 enter = vec3(0.0), leave = vec3(0.0);
+    float sum = above_unit_edge(a, b, ua, ub, ha, hb, n, enter, leave)
+              + above_unit_edge(b, c, ub, uc, hb, hc, n, enter, leave)
+              + above_unit_edge(c, a, uc, ua, hc, ha, n, enter, leave);
+    if (min(ha, min(hb, hc)) < 0.0) sum += lambert_edge(leave, enter, n);
     return abs(sum) * 0.5;
 }
 
