@@ -59,6 +59,63 @@ float surface_along(vec3 uvw, int a, float idx, float texel, float lod) {
     return tau > 0.0 ? layer / tau : -1.0;
 }
 
+// Where along axis a (a constant at each call: it indexes u_volume) the surfaces of the texels in `bits` lie (bit k:
+// texel mid − 1 + k around the step's sample g), in the columns through the step's start and end (wa, wb, index
+// 3a + k; −1: none there, or the other end's where only one has one).
+void reach_axis(const int a, uint bits, vec3 g, float texel, float lod, vec3 uvw_a, vec3 uvw_b, inout float wa[9],
+                inout float wb[9], inout bool any_surface) {
+    while (bits != 0u) {
+        int k = findLSB(bits);
+        bits &= bits - 1u;
+        int n = 3 * a + k;
+        float idx = floor(g[a] / texel) - 1.0 + float(k);
+        wa[n] = surface_along(uvw_a, a, idx, texel, lod);
+        wb[n] = surface_along(uvw_b, a, idx, texel, lod);
+        if (wa[n] < 0.0) wa[n] = wb[n];
+        if (wb[n] < 0.0) wb[n] = wa[n];
+        any_surface = any_surface || wa[n] >= 0.0;
+    }
+}
+
+// The surfaces across axis a (a constant at each call: it indexes u_volume) that the sub-rays cross in this step
+// (bit 3j + k: sub-ray j through texel k's surfaces, from its start ga[j] to its end gb[j]), in that order: each
+// gathers α·S of what is left of it. A sub-ray meets its crossings on the three axes in the order the search found
+// them, so its transmittance is the same whichever axis is read first.
+void cross_axis(const int a, uint bits, vec3 ga[SUBRAYS], vec3 gb[SUBRAYS], float wa[9], float wb[9], float texel,
+                float lod, vec3 inv_size, inout float T[SUBRAYS], inout vec3 radiance) {
+    const float inv_ns = 1.0 / float(SUBRAYS);
+    float hit_lod = max(lod - 1.0, 0.0);
+    float hit_texel = exp2(hit_lod);
+    while (bits != 0u) {
+        int bit = findLSB(bits);
+        bits &= bits - 1u;
+        int j = bit / 3, n = 3 * a + bit - 3 * (bit / 3);
+        vec3 m = gb[j] - ga[j];
+        float fa = (wa[n] - ga[j][a]) * sign(m[a]), fb = (wb[n] - gb[j][a]) * sign(m[a]);
+        vec3 hit = ga[j] + m * (fa / (fa - fb));
+        // What the sub-ray meets is read one level finer than the cone, in its own column, over the whole depth of
+        // the crossed texel (its two finer texels along a, front first): a tilted surface lies in either of them
+        // there, wherever the texel's mean depth put the crossing.
+        float idx = floor(hit[a] / texel);
+        int parts = lod > 0.0 ? 2 : 1;
+        for (int h = 0; h < parts; ++h) {
+            float fine = parts == 1 ? idx : 2.0 * idx + float(m[a] > 0.0 ? h : 1 - h);
+            vec3 q = hit;
+            q[a] = (fine + 0.5) * hit_texel;
+            q *= inv_size;
+            vec4 s = m[a] > 0.0 ? textureLod(u_volume[2 * a], q, hit_lod)
+                                : textureLod(u_volume[2 * a + 1], q, hit_lod);
+            if (s.a <= 0.0) continue;
+            float alpha = min(1.0 - exp(-s.a), T[j]);
+            radiance += inv_ns * alpha * s.rgb / s.a;   // vct/hits.glsl replays this term
+#if defined(MODE_RECORD)
+            record_hit(q, hit_lod, m[a] > 0.0 ? 2 * a : 2 * a + 1, alpha);
+#endif
+            T[j] -= alpha;
+        }
+    }
+}
+
 ConeResult trace_cone_crossing(vec3 o, vec3 d, float tan_half) {
     float ao_limit = u_ao_distance > 0.0 ? u_ao_distance : 3.4e38;
     ConeResult r = ConeResult(vec3(0.0), 1.0, false, 1.0);
@@ -134,24 +191,14 @@ ConeResult trace_cone_crossing(vec3 o, vec3 d, float tan_half) {
                 reached |= 1u << n;
             }
         }
-        while (reached != 0u) {
-            int n = findLSB(reached);
-            reached &= reached - 1u;
-            int a = n / 3;
-            float idx = floor(g[a] / texel) - 1.0 + float(n - 3 * a);
-            wa[n] = surface_along(uvw_a, a, idx, texel, lod);
-            wb[n] = surface_along(uvw_b, a, idx, texel, lod);
-            if (wa[n] < 0.0) wa[n] = wb[n];
-            if (wb[n] < 0.0) wb[n] = wa[n];
-            any_surface = any_surface || wa[n] >= 0.0;
-        }
-        float hit_lod = max(lod - 1.0, 0.0);
-        float hit_texel = exp2(hit_lod);
-        // The crossings are found first and read after: one bit per sub-ray j and texel n (bit 9j + n, the order
-        // they are taken in, as the loops over j, a, k found them). llvmpipe runs a loop's body for every SIMD lane
-        // whenever one lane needs it, so reading while searching read two textures for each of the SUBRAYS × 9
-        // candidates at every step (as vct/arrays.glsl's switches); only crossings are read now.
-        uvec2 crossed = uvec2(0u);
+        reach_axis(0, reached & 7u, g, texel, lod, uvw_a, uvw_b, wa, wb, any_surface);
+        reach_axis(1, (reached >> 3) & 7u, g, texel, lod, uvw_a, uvw_b, wa, wb, any_surface);
+        reach_axis(2, reached >> 6, g, texel, lod, uvw_a, uvw_b, wa, wb, any_surface);
+        // The crossings are found first and read after (cross_axis): per axis a, one bit per sub-ray j and texel k
+        // (bit 3j + k). llvmpipe runs a loop's body for every SIMD lane whenever one lane needs it, so reading while
+        // searching read two textures for each of the SUBRAYS × 9 candidates at every step (as vct/arrays.glsl's
+        // switches); only crossings are read now.
+        uvec3 crossed = uvec3(0u);
         for (int j = 0; j < ns && any_surface; ++j) {   // in empty space there is nothing to cross
             if (T[j] < MIN_TRANSMITTANCE) continue;
             vec3 m = gb[j] - ga[j];
@@ -167,43 +214,13 @@ ConeResult trace_cone_crossing(vec3 o, vec3 d, float tan_half) {
                     if (fa <= 0.0 || fb > 0.0) continue;
                     vec3 hit = ga[j] + m * (fa / (fa - fb));
                     if (any(lessThan(hit, vec3(0.0))) || any(greaterThan(hit, size))) continue;   // beyond the grid
-                    int bit = 9 * j + n;
-                    if (bit < 32) crossed.x |= 1u << bit;
-                    else crossed.y |= 1u << (bit - 32);
+                    crossed[a] |= 1u << (3 * j + k);
                 }
             }
         }
-        for (int word = 0; word < 2; ++word) {
-            uint bits = word == 0 ? crossed.x : crossed.y;
-            while (bits != 0u) {
-                int bit = 32 * word + findLSB(bits);
-                bits &= bits - 1u;
-                int j = bit / 9, n = bit - 9 * (bit / 9), a = n / 3;
-                vec3 m = gb[j] - ga[j];
-                float fa = (wa[n] - ga[j][a]) * sign(m[a]), fb = (wb[n] - gb[j][a]) * sign(m[a]);
-                vec3 hit = ga[j] + m * (fa / (fa - fb));
-                // What the sub-ray meets is read one level finer than the cone, in its own column, over the
-                // whole depth of the crossed texel (its two finer texels along a, front first): a tilted
-                // surface lies in either of them there, wherever the texel's mean depth put the crossing.
-                float idx = floor(hit[a] / texel);
-                int parts = lod > 0.0 ? 2 : 1;
-                for (int h = 0; h < parts; ++h) {
-                    float fine = parts == 1 ? idx : 2.0 * idx + float(m[a] > 0.0 ? h : 1 - h);
-                    vec3 q = hit;
-                    q[a] = (fine + 0.5) * hit_texel;
-                    q *= inv_size;
-                    vec4 s = m[a] > 0.0 ? textureLod(u_volume[2 * a], q, hit_lod)
-                                        : textureLod(u_volume[2 * a + 1], q, hit_lod);
-                    if (s.a <= 0.0) continue;
-                    float alpha = min(1.0 - exp(-s.a), T[j]);
-                    r.radiance += inv_ns * alpha * s.rgb / s.a;   // vct/hits.glsl replays this term
-#if defined(MODE_RECORD)
-                    record_hit(q, hit_lod, m[a] > 0.0 ? 2 * a : 2 * a + 1, alpha);
-#endif
-                    T[j] -= alpha;
-                }
-            }
-        }
+        cross_axis(0, crossed.x, ga, gb, wa, wb, texel, lod, inv_size, T, r.radiance);
+        cross_axis(1, crossed.y, ga, gb, wa, wb, texel, lod, inv_size, T, r.radiance);
+        cross_axis(2, crossed.z, ga, gb, wa, wb, texel, lod, inv_size, T, r.radiance);
         seg_start = seg_end;
         t += STEP_TEXELS * texel;
     }
