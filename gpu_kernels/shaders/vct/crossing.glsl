@@ -49,6 +49,7 @@ uniform float u_subray_radius;    // their distance from the axis, in units of t
 
 // Where along axis a the surfaces of texel `idx` (of size `texel`, level `lod`) lie, in the column through uvw:
 // the τ-weighted mean position of the layer volume (vct/mipmap.glsl MODE_LAYERS), or −1 where the texel is empty.
+// `a` must be the same in every lane (a constant: reach_axis): it indexes u_volume.
 float surface_along(vec3 uvw, int a, float idx, float texel, float lod) {
     vec3 q = uvw;
     q[a] = (idx + 0.5) * texel / float(u_grid_size[a]);
