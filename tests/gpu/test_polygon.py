@@ -71,7 +71,10 @@ def _cases(rng, count):
     return np.array(octagons), probes
 
 
-def test_split_octagon_projected_solid_angles_match_clipping_then_lambert(tmp_path):
+def _run_probe(tmp_path, source: str, inputs: list, out_floats: int, count: int) -> np.ndarray:
+    """Compute shader `source` (it may include the repository's shaders) over `count` invocations, with `inputs` on
+    storage buffers 0, 1, … and an output buffer of `out_floats` floats an invocation after them: its (count,
+    out_floats) float64 result."""
     moderngl = pytest.importorskip("moderngl")
     from bounce_gi.gpu_kernels.gl import preprocessor as spp
 
@@ -79,6 +82,22 @@ def test_split_octagon_projected_solid_angles_match_clipping_then_lambert(tmp_pa
         ctx = moderngl.create_standalone_context(backend="egl", require=430)
     except Exception as exc:  # no EGL / GL 4.3 here
         pytest.skip(f"no OpenGL 4.3 context: {exc}")
+    src = tmp_path / "probe.glsl"
+    src.write_text(source)
+    prog = ctx.compute_shader(spp.preprocess(src, search_dirs=[spp.SHADER_DIR]).text)
+    bufs = [ctx.buffer(a.tobytes()) for a in inputs] + [ctx.buffer(reserve=count * 4 * out_floats)]
+    for i, b in enumerate(bufs):
+        b.bind_to_storage_buffer(i)
+    prog.run(count, 1, 1)
+    out = np.frombuffer(bufs[-1].read(), np.float32).reshape(count, out_floats).astype(np.float64)
+    for b in bufs:
+        b.release()
+    prog.release()
+    ctx.release()
+    return out
+
+
+def test_split_octagon_projected_solid_angles_match_clipping_then_lambert(tmp_path):
     count = 256
     octagons, probes = _cases(np.random.default_rng(5), count)
     corners = np.zeros((count, 8, 4), np.float32)
@@ -86,18 +105,7 @@ def test_split_octagon_projected_solid_angles_match_clipping_then_lambert(tmp_pa
     probe = np.zeros((count, 2, 4), np.float32)
     probe[:, 0, :3] = [p for p, _ in probes]
     probe[:, 1, :3] = [n for _, n in probes]
-    src = tmp_path / "probe.glsl"
-    src.write_text(PROBE)
-    prog = ctx.compute_shader(spp.preprocess(src, search_dirs=[spp.SHADER_DIR]).text)
-    bufs = [ctx.buffer(corners.tobytes()), ctx.buffer(probe.tobytes()), ctx.buffer(reserve=count * 8)]
-    for i, b in enumerate(bufs):
-        b.bind_to_storage_buffer(i)
-    prog.run(count, 1, 1)
-    ours = np.frombuffer(bufs[2].read(), np.float32).reshape(count, 2).astype(np.float64)
-    for b in bufs:
-        b.release()
-    prog.release()
-    ctx.release()
+    ours = _run_probe(tmp_path, PROBE, [corners, probe], 2, count)
     exact, kinds = np.zeros((count, 2)), set()
     for i, octagon in enumerate(corners[..., :3].astype(np.float64)):  # the float32 inputs the shader got
         q = octagon - probe[i, 0, :3].astype(np.float64)
@@ -130,31 +138,13 @@ def test_triangle_projected_solid_angles_are_both_sides_of_one_triangle(tmp_path
     """triangle_projected_solid_angles (VCT's injection lights both sides of a surface point with it) against the
     clip-then-Lambert reference for n and −n, and against two calls of the one-sided triangle_projected_solid_angle:
     triangles whole above, whole below and cut by the receiver's plane."""
-    moderngl = pytest.importorskip("moderngl")
-    from bounce_gi.gpu_kernels.gl import preprocessor as spp
-
-    try:
-        ctx = moderngl.create_standalone_context(backend="egl", require=430)
-    except Exception as exc:  # no EGL / GL 4.3 here
-        pytest.skip(f"no OpenGL 4.3 context: {exc}")
     count = 256
     octagons, probes = _cases(np.random.default_rng(7), count)
     cases = np.zeros((count, 5, 4), np.float32)
     cases[:, :3, :3] = octagons[:, [0, 3, 5]]  # three of a convex octagon's corners: a triangle in its plane
     cases[:, 3, :3] = [p for p, _ in probes]
     cases[:, 4, :3] = [n for _, n in probes]
-    src = tmp_path / "triangle.glsl"
-    src.write_text(TRIANGLE_PROBE)
-    prog = ctx.compute_shader(spp.preprocess(src, search_dirs=[spp.SHADER_DIR]).text)
-    bufs = [ctx.buffer(cases.tobytes()), ctx.buffer(reserve=count * 16)]
-    for i, b in enumerate(bufs):
-        b.bind_to_storage_buffer(i)
-    prog.run(count, 1, 1)
-    ours = np.frombuffer(bufs[1].read(), np.float32).reshape(count, 4).astype(np.float64)
-    for b in bufs:
-        b.release()
-    prog.release()
-    ctx.release()
+    ours = _run_probe(tmp_path, TRIANGLE_PROBE, [cases], 4, count)
     exact, kinds = np.zeros((count, 2)), set()
     for i, case in enumerate(cases[..., :3].astype(np.float64)):
         q, n = case[:3] - case[3], case[4]
