@@ -9,6 +9,11 @@ from .cones import MAX_CONES, valid_cone_count
 
 MAX_SUBRAYS = 7  # vct/crossing.glsl keeps them in registers (a define per count)
 CONE_FIELDS = ("diffuse_cones", "diffuse_aperture", "max_distance", "step_multiplier", "start_offset")
+# The narrowest diffuse cone (degrees). A cone steps one texel of its own level at a time (vct/crossing.glsl), so a
+# narrow one takes many steps, each a few loop iterations, and llvmpipe ends a shader invocation's loops silently
+# after 65535 iterations in all (lpv/gather.vpls_per_dispatch): 31 cones of 5° at 512³ take about 1 500 steps
+# (49 a cone), 1° about 5 300.
+MIN_APERTURE = 5.0
 
 
 @dataclass(frozen=True)
@@ -93,8 +98,8 @@ class VctSettings:
              f"subrays {self.subrays} out of range 1..{MAX_SUBRAYS}"),
             (self.bounce_cones == 0 or valid_cone_count(self.bounce_cones),
              f"bounce_cones {self.bounce_cones} must be 0 (= diffuse_cones), 5..9 or 13, 16, 19, … {MAX_CONES - 1}"),
-            (self.diffuse_aperture == 0 or 0 < self.diffuse_aperture < 90,
-             f"diffuse_aperture {self.diffuse_aperture} must be 0 (derived) or in (0, 90) degrees"),
+            (self.diffuse_aperture == 0 or MIN_APERTURE <= self.diffuse_aperture < 90,
+             f"diffuse_aperture {self.diffuse_aperture} must be 0 (derived) or in [{MIN_APERTURE:g}, 90) degrees"),
             (self.max_distance >= 0 and math.isfinite(self.max_distance), "max_distance must be ≥ 0 (0 = unlimited)"),
             (1 <= self.bounces <= 16, f"bounces {self.bounces} out of range 1..16"),
             (0.0 <= self.epsilon < 1.0, f"epsilon {self.epsilon} out of range [0, 1)"),

@@ -310,7 +310,7 @@ def test_passes_rerun_only_downstream_and_ao_is_sky_visibility(engine, furnace):
 @pytest.mark.parametrize("bad", [dict(resolution=8), dict(resolution=1024), dict(diffuse_cones=4),
                                  dict(diffuse_cones=10), dict(diffuse_cones=12), dict(diffuse_cones=17),
                                  dict(diffuse_cones=34), dict(bounce_cones=14), dict(diffuse_aperture=-1.0),
-                                 dict(diffuse_aperture=90.0),
+                                 dict(diffuse_aperture=90.0), dict(diffuse_aperture=1.0),
                                  dict(max_distance=-1.0), dict(bounces=0), dict(bounces=17),
                                  dict(gathered_bounces=1), dict(gathered_bounces=17), dict(gathered_bounces=-1),
                                  dict(bounce_cones=4), dict(bounce_cones=10),

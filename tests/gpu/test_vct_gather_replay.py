@@ -80,21 +80,29 @@ def test_the_record_orders_each_run_of_faces_by_its_steps(monkeypatch):
     run of ORDER_BLOCK entries the faces with the most recorded steps come first, and the list still holds every
     face with coverage once (the replays equal plain gathers: test_replayed_gathers_are_the_gathers)."""
     monkeypatch.setattr(bounce, "ORDER_BLOCK", 64)
+
+    def read(listed, pool, count):
+        headers = np.frombuffer(pool.headers.read(size=16 * count), np.uint32).reshape(count, 4).copy()
+        return headers, np.frombuffer(listed.read(size=16 * count), np.int32).reshape(count, 4).copy()
+
+    recorded = []  # each face's header as the record left it, before the reorder
+    order = bounce.order_by_steps
+    monkeypatch.setattr(bounce, "order_by_steps",
+                        lambda listed, pool, count: (recorded.append(read(listed, pool, count)),
+                                                     order(listed, pool, count)))
     engine = Engine()
     try:
         engine.render(_room(), SETTINGS)
         shared = engine.pipeline.cache.entries["vct_geometry"].value
         listed, count = shared.face_list
-
-        def read():
-            steps = np.frombuffer(shared.gather_pool.headers.read(size=16 * count), np.uint32).reshape(count, 4)[:, 1]
-            return steps.astype(np.int64), np.frombuffer(listed.read(size=16 * count), np.int32).reshape(count, 4)
-
-        steps, entries = engine.worker.call(lambda ctx: read())
-        assert count > 4 * 64 and len(np.unique(steps)) > 10
+        headers, entries = engine.worker.call(lambda ctx: read(listed, shared.gather_pool, count))
+        steps = headers[:, 1].astype(np.int64)
+        assert len(recorded) == 1 and count > 4 * 64 and len(np.unique(steps)) > 10
         runs = steps[: count // 64 * 64].reshape(-1, 64)
         assert (np.diff(runs, axis=1) <= 0).all()
         assert not (np.diff(steps) <= 0).all()  # runs, not one sort over the whole list
-        assert len({tuple(e) for e in entries}) == count
+        headers0, entries0 = recorded[0]
+        before = {tuple(e): tuple(h) for e, h in zip(entries0, headers0)}  # each face keeps its own header
+        assert len(before) == count and {tuple(e): tuple(h) for e, h in zip(entries, headers)} == before
     finally:
         engine.shutdown()

@@ -46,6 +46,9 @@ uniform float u_subray_radius;    // their distance from the axis, in units of t
 // texels read around each sample cover (see `limit` below); measured against half a texel (19 cones): Cornell / spot
 // room / courtyard Diffuse Indirect 0.074 / 0.058 / 0.070 vs 0.079 / 0.056 / 0.070, at 1.6× the time for the latter.
 #define STEP_TEXELS 1.0
+#if SUBRAYS > 10
+#error "cross_axis keeps 3 bits per sub-ray in one uint"
+#endif
 
 // Where along axis a the surfaces of texel `idx` (of size `texel`, level `lod`) lie, in the column through uvw:
 // the τ-weighted mean position of the layer volume (vct/mipmap.glsl MODE_LAYERS), or −1 where the texel is empty.
@@ -80,8 +83,9 @@ void reach_axis(const int a, uint bits, vec3 g, float texel, float lod, vec3 uvw
 
 // The surfaces across axis a (a constant at each call: it indexes u_volume) that the sub-rays cross in this step
 // (bit 3j + k: sub-ray j through texel k's surfaces, from its start ga[j] to its end gb[j]), in that order: each
-// gathers α·S of what is left of it. A sub-ray meets its crossings on the three axes in the order the search found
-// them, so its transmittance is the same whichever axis is read first.
+// gathers α·S of what is left of it. Called for the axes in order 0, 1, 2, so each sub-ray meets its crossings in
+// the order the search found them (α = min(1 − e^−τ, T_j) depends on it); only the sum over sub-rays is taken axis
+// by axis.
 void cross_axis(const int a, uint bits, vec3 ga[SUBRAYS], vec3 gb[SUBRAYS], float wa[9], float wb[9], float texel,
                 float lod, vec3 inv_size, inout float T[SUBRAYS], inout vec3 radiance) {
     const float inv_ns = 1.0 / float(SUBRAYS);
