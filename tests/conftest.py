@@ -18,9 +18,6 @@ MARKERS = ("unit", "gpu", "blender", "accuracy", "stress")
 def pytest_addoption(parser):
     parser.addoption("--stress-full", action="store_true", default=False,
                      help="tests/stress: the longer cases too (larger grids, more bounces, more random scenes)")
-    parser.addoption("--slow", action="store_true", default=False,
-                     help="tests/accuracy: the cases marked slow too (test_examples_vs_cycles: VCT on the slowest "
-                          "example scenes)")
 
 
 def pytest_collection_modifyitems(items):

@@ -191,11 +191,9 @@ BOUNDS = {
 }
 
 METHODS = ("lpv", "vct")
-# Both methods on all twelve scenes took 6 min 56 s here (llvmpipe, 2 cores shared with other work; LPV 92 s and
-# VCT 320 s of rendering), 4 min 36 s when the machine was quieter: VCT on its four slowest scenes (173 s of the
-# 320) is marked slow and runs with --slow. The default run (CI) renders LPV on every scene and VCT on eight:
-# 2 min 52 s here (the slow part alone 1 min 44 s).
-SLOW = {("furnished", "vct"), ("cornell_animated", "vct"), ("lamp_room", "vct"), ("window_room", "vct")}
+# Both methods on all twelve scenes: 60 s here (llvmpipe, 2 cores; 2026-12-07, stop 53). VCT's four slowest scenes
+# were marked slow while the run took 6 min 56 s; since VCT's trace, replays and emitters got faster every pair runs
+# in the default run (CI).
 
 
 @pytest.fixture(scope="module")
@@ -246,9 +244,7 @@ def test_references_are_the_projects_cycles_settings():
 
 
 def _cases():
-    return [pytest.param(name, method, id=f"{name}-{method}",
-                         marks=[pytest.mark.slow] if (name, method) in SLOW else [])
-            for name in references.FRAMES for method in METHODS]
+    return [pytest.param(name, method, id=f"{name}-{method}") for name in references.FRAMES for method in METHODS]
 
 
 @pytest.mark.parametrize("name,method", _cases())
