@@ -93,6 +93,27 @@ void polygon_triangle(GpuLight L, int t, out vec3 a, out vec3 b, out vec3 c, out
 // rasterised on the emitter itself at a grazing angle is up to 1e-3 of its size off (measured: a lamp shade's RSM
 // texels lit themselves, the shade's first bounce 2.6× what the room reflected). Irradiance = color_type.rgb × this.
 #define SELF_PLANE 1e-2
+#if !defined(NO_TRIANGLE_LISTS)
+// The triangle list's triangle at polygon_vertices[i] (vertices relative to p, its relative radiance), false where p
+// gets none of its light: behind a one-sided triangle, or on it.
+bool emitter_triangle_seen(int i, vec3 p, out vec3 a, out vec3 b, out vec3 c, out vec3 scale) {
+    a = polygon_vertices[i].xyz - p;
+    b = polygon_vertices[i + 1].xyz - p;
+    c = polygon_vertices[i + 2].xyz - p;
+    vec4 s = polygon_vertices[i + 3];
+    scale = s.rgb;
+    vec3 tn = cross(b - a, c - a);
+    float len = length(tn);
+    float height = -dot(a, tn) / max(len, 1e-30);   // p above the triangle's plane, along its winding normal
+    if (s.w > 0.5 && height < 0.0) return false;   // behind a one-sided triangle
+    if (abs(height) <= SELF_PLANE * sqrt(0.5 * len)) {   // on its plane: on it, if over it (barycentrics > 1e-3)
+        vec3 edges = vec3(dot(cross(b - a, -a), tn), dot(cross(c - b, -b), tn), dot(cross(a - c, -c), tn));
+        if (min(edges.x, min(edges.y, edges.z)) > 1e-3 * len * len) return false;
+    }
+    return true;
+}
+#endif
+
 vec3 polygon_light_solid_angle(GpuLight L, vec3 p, vec3 n) {
     int first = int(L.polygon.x), count = int(L.polygon.y);
 #if defined(NO_TRIANGLE_LISTS)
@@ -101,17 +122,8 @@ vec3 polygon_light_solid_angle(GpuLight L, vec3 p, vec3 n) {
     if (L.polygon.w < 0.5) return vec3(polygon_projected_solid_angle(first, count, p, n));
     vec3 sum = vec3(0.0);
     for (int i = first; i < first + count; i += 4) {
-        vec3 a = polygon_vertices[i].xyz - p, b = polygon_vertices[i + 1].xyz - p, c = polygon_vertices[i + 2].xyz - p;
-        vec4 scale = polygon_vertices[i + 3];
-        vec3 tn = cross(b - a, c - a);
-        float len = length(tn);
-        float height = -dot(a, tn) / max(len, 1e-30);   // p above the triangle's plane, along its winding normal
-        if (scale.w > 0.5 && height < 0.0) continue;   // behind a one-sided triangle
-        if (abs(height) <= SELF_PLANE * sqrt(0.5 * len)) {   // on its plane: on it, if over it (barycentrics > 1e-3)
-            vec3 edges = vec3(dot(cross(b - a, -a), tn), dot(cross(c - b, -b), tn), dot(cross(a - c, -c), tn));
-            if (min(edges.x, min(edges.y, edges.z)) > 1e-3 * len * len) continue;
-        }
-        sum += triangle_projected_solid_angle(a, b, c, n) * scale.rgb;
+        vec3 a, b, c, scale;
+        if (emitter_triangle_seen(i, p, a, b, c, scale)) sum += triangle_projected_solid_angle(a, b, c, n) * scale;
     }
     return sum;
 #endif
@@ -126,20 +138,11 @@ vec3 polygon_light_solid_angles(GpuLight L, vec3 p, vec3 n, out vec3 back) {
         vec3 front = vec3(0.0);
         back = vec3(0.0);
         for (int i = first; i < first + count; i += 4) {
-            vec3 a = polygon_vertices[i].xyz - p, b = polygon_vertices[i + 1].xyz - p;
-            vec3 c = polygon_vertices[i + 2].xyz - p;
-            vec4 scale = polygon_vertices[i + 3];
-            vec3 tn = cross(b - a, c - a);
-            float len = length(tn);
-            float height = -dot(a, tn) / max(len, 1e-30);
-            if (scale.w > 0.5 && height < 0.0) continue;   // as polygon_light_solid_angle
-            if (abs(height) <= SELF_PLANE * sqrt(0.5 * len)) {
-                vec3 edges = vec3(dot(cross(b - a, -a), tn), dot(cross(c - b, -b), tn), dot(cross(a - c, -c), tn));
-                if (min(edges.x, min(edges.y, edges.z)) > 1e-3 * len * len) continue;
-            }
+            vec3 a, b, c, scale;
+            if (!emitter_triangle_seen(i, p, a, b, c, scale)) continue;
             vec2 both = triangle_projected_solid_angles(a, b, c, n);
-            front += both.x * scale.rgb;
-            back += both.y * scale.rgb;
+            front += both.x * scale;
+            back += both.y * scale;
         }
         return front;
     }

@@ -47,8 +47,11 @@ float triangle_projected_solid_angle(vec3 a, vec3 b, vec3 c, vec3 n) {
     return abs(sum) * 0.5;
 }
 
-// split_edge for edge a→b given its unit directions: two edge terms whether or not it crosses the plane (the piece
-// on a's side, and the piece past the crossing, 0 where there is none).
+// One edge a→b (unit directions ua, ub) of a convex polygon split by the plane through the receiver (heights ha,
+// hb): its terms of Lambert's formula above the plane (x) and below it (y), and where it leaves (`leave`) or enters
+// (`enter`) the side above. Two terms whether or not it crosses (the piece on a's side, and the piece past the
+// crossing, 0 where there is none: llvmpipe runs both sides of a branch). An edge of length 0 (an octagon that is a
+// rectangle) adds nothing.
 vec2 split_unit_edge(vec3 a, vec3 b, vec3 ua, vec3 ub, float ha, float hb, vec3 n, inout vec3 enter,
                      inout vec3 leave) {
     bool crosses = (ha >= 0.0) != (hb >= 0.0);
@@ -79,24 +82,6 @@ vec2 triangle_projected_solid_angles(vec3 a, vec3 b, vec3 c, vec3 n) {
     return 0.5 * abs(sum + vec2(closing, -closing)) * vec2(up, down);
 }
 
-// One edge a→b of a convex polygon split by the plane through the receiver (heights ha, hb): its terms of Lambert's
-// formula above the plane (x) and below it (y), and where it leaves (`leave`) or enters (`enter`) the side above.
-// Edges of length 0 (an octagon that is a rectangle) add nothing.
-vec2 split_edge(vec3 a, vec3 b, float ha, float hb, vec3 n, inout vec3 enter, inout vec3 leave) {
-    if (a == b) return vec2(0.0);
-    if ((ha >= 0.0) == (hb >= 0.0)) {
-        float whole = lambert_edge(a, b, n);
-        return ha >= 0.0 ? vec2(whole, 0.0) : vec2(0.0, whole);
-    }
-    vec3 c = cut(a, b, ha, hb);
-    if (ha >= 0.0) {
-        leave = c;
-        return vec2(lambert_edge(a, c, n), lambert_edge(c, b, n));
-    }
-    enter = c;
-    return vec2(lambert_edge(c, b, n), lambert_edge(a, c, n));
-}
-
 // The projected solid angles, seen from the receiver (the origin) with normal n (x) and with −n (y), of the parts of
 // the convex octagon q0…q7 above and below its plane (edges may have length 0: a rectangle is an octagon too). Each
 // part is its own edges' pieces closed along the plane, leave → enter above and enter → leave below; Lambert's terms
@@ -106,11 +91,17 @@ vec2 split_octagon_projected_solid_angles(vec3 q0, vec3 q1, vec3 q2, vec3 q3, ve
                                           vec3 q7, vec3 n) {
     vec4 u = vec4(dot(q0, n), dot(q1, n), dot(q2, n), dot(q3, n));
     vec4 w = vec4(dot(q4, n), dot(q5, n), dot(q6, n), dot(q7, n));
+    vec3 u0 = normalize(q0), u1 = normalize(q1), u2 = normalize(q2), u3 = normalize(q3);
+    vec3 u4 = normalize(q4), u5 = normalize(q5), u6 = normalize(q6), u7 = normalize(q7);
     vec3 enter = vec3(0.0), leave = vec3(0.0);
-    vec2 sum = split_edge(q0, q1, u.x, u.y, n, enter, leave) + split_edge(q1, q2, u.y, u.z, n, enter, leave)
-             + split_edge(q2, q3, u.z, u.w, n, enter, leave) + split_edge(q3, q4, u.w, w.x, n, enter, leave)
-             + split_edge(q4, q5, w.x, w.y, n, enter, leave) + split_edge(q5, q6, w.y, w.z, n, enter, leave)
-             + split_edge(q6, q7, w.z, w.w, n, enter, leave) + split_edge(q7, q0, w.w, u.x, n, enter, leave);
+    vec2 sum = split_unit_edge(q0, q1, u0, u1, u.x, u.y, n, enter, leave)
+             + split_unit_edge(q1, q2, u1, u2, u.y, u.z, n, enter, leave)
+             + split_unit_edge(q2, q3, u2, u3, u.z, u.w, n, enter, leave)
+             + split_unit_edge(q3, q4, u3, u4, u.w, w.x, n, enter, leave)
+             + split_unit_edge(q4, q5, u4, u5, w.x, w.y, n, enter, leave)
+             + split_unit_edge(q5, q6, u5, u6, w.y, w.z, n, enter, leave)
+             + split_unit_edge(q6, q7, u6, u7, w.z, w.w, n, enter, leave)
+             + split_unit_edge(q7, q0, u7, u0, w.w, u.x, n, enter, leave);
     bool above = any(greaterThanEqual(u, vec4(0.0))) || any(greaterThanEqual(w, vec4(0.0)));
     bool below = any(lessThan(u, vec4(0.0))) || any(lessThan(w, vec4(0.0)));
     float closing = above && below ? lambert_edge(leave, enter, n) : 0.0;

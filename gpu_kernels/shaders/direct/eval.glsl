@@ -283,6 +283,11 @@ float sky_visibility(GpuLight L, vec3 p, vec3 n, vec3 geo_n) {
     return wsum > 0.0 ? vsum / wsum : 0.0;
 }
 
+// A one-sided polygon light (an area light) shines along its `direction` only: p behind its plane gets nothing.
+bool behind_polygon(GpuLight L, vec3 p) {
+    return L.polygon.z < 0.5 && dot(p - L.position.xyz, L.direction.xyz) <= 0.0;
+}
+
 // Unshadowed direct irradiance of one light at p (normal n).
 vec3 light_unshadowed(GpuLight L, vec3 p, vec3 n) {
     int type = int(L.color_type.w);
@@ -299,8 +304,7 @@ vec3 light_unshadowed(GpuLight L, vec3 p, vec3 n) {
         // position.w = r² for Cycles' soft-falloff disk (E = I·cosθ/(d²+r²)), 0 for a point or sphere light.
         return color * att * cosine / (d2 + L.position.w);
     }
-    // Polygon light: one-sided lights shine along `direction` only.
-    if (L.polygon.z < 0.5 && dot(p - L.position.xyz, L.direction.xyz) <= 0.0) return vec3(0.0);
+    if (behind_polygon(L, p)) return vec3(0.0);
     return color * polygon_light_solid_angle(L, p, n);
 }
 
@@ -309,7 +313,7 @@ vec3 light_unshadowed(GpuLight L, vec3 p, vec3 n) {
 vec3 light_unshadowed_sides(GpuLight L, vec3 p, vec3 n, out vec3 back) {
     if (int(L.color_type.w) == LIGHT_POLYGON) {
         back = vec3(0.0);
-        if (L.polygon.z < 0.5 && dot(p - L.position.xyz, L.direction.xyz) <= 0.0) return vec3(0.0);
+        if (behind_polygon(L, p)) return vec3(0.0);
         vec3 front = L.color_type.rgb * polygon_light_solid_angles(L, p, n, back);
         back *= L.color_type.rgb;
         return front;
