@@ -166,12 +166,12 @@ def zero_texture(ctx, texture) -> None:
         texture.write(zeros, viewport=(0, 0, z, texture.width, texture.height, min(slab, depth - z)))
 
 
-def texture3d(ctx, size, levels: int = 1, zero: bool = False):
-    """An RGBA32F volume; `zero`: filled with zeros, so passes may skip storing to empty voxels (llvmpipe image
+def texture3d(ctx, size, levels: int = 1, zero: bool = False, dtype: str = "f4"):
+    """An RGBA32F volume (RGBA16F with dtype "f2"); `zero`: filled with zeros, so passes may skip storing to empty voxels (llvmpipe image
     stores are slow: storing 12 zeros to every empty voxel took 1 s of vct_inject at 128³)."""
     import moderngl
 
-    t = ctx.texture3d(tuple(int(n) for n in size), 4, None, dtype="f4")
+    t = ctx.texture3d(tuple(int(n) for n in size), 4, None, dtype=dtype)
     if zero:
         zero_texture(ctx, t)
     t.repeat_x = t.repeat_y = t.repeat_z = False

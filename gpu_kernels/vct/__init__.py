@@ -2,12 +2,15 @@
 """Voxel Cone Tracing (Crassin et al. 2011; Freed 2018): voxelize → inject direct light → mipmap → bounce → trace.
 
 Passes (vct/passes.py runs them through the pass cache):
-  vct_voxelize  the shared GPU voxelizer (voxel/voxelize.py) on a grid padded so every mip level nests exactly;
+  vct_voxelize  the shared GPU voxelizer (voxel/voxelize.py) on a grid padded so every mip level nests exactly:
+                the surfaces' areas and normals;
+  vct_albedo    each voxel face's albedo, from the surface points whose light leaves through it (vct/inject.py,
+                vct/face_albedo.glsl): a material's colour edit re-makes this, not the voxels or the light;
   vct_inject    surface points rasterised along their dominant axis and lit by every light exactly as the Diffuse
-                Direct pass lights pixels (direct/eval.glsl), averaged into six faces per voxel: the radiance
-                leaving through each face, its coverage and where its surfaces lie (vct/inject*.glsl); the lamps,
-                the emissive meshes and the sky each in a pass of its own, summed, so an edit re-injects only its
-                part (vct/parts.py);
+                Direct pass lights pixels (direct/eval.glsl), averaged into six faces per voxel: the light arriving
+                through each face, its coverage and where its surfaces lie (vct/inject*.glsl); the lamps, the
+                emissive meshes and the sky each in a pass of its own, summed and multiplied by the faces' albedo,
+                so an edit re-injects only its part (vct/parts.py);
   vct_mipmap    the filtered radiance volumes: isotropic (mean of children) or anisotropic (six directions,
                 composited front to back, plus where each texel's surfaces lie along each axis, so a cone skips
                 surfaces behind where it started) (vct/mipmap.glsl, Freed 2018, §4.4);

@@ -14,10 +14,10 @@ from .inject import face_flux
 from .mipmap import build_volumes
 from .settings import VctSettings
 from .trace import bind_cones
-from .volumes import ConeVolumes, Faces, VoxelGeometry, bind_volumes, gather_levels
+from .volumes import ConeVolumes, FaceAlbedo, Faces, VoxelGeometry, bind_volumes, gather_levels
 
 
-def bounce(ctx, programs, vox, direct_faces: Faces, volumes: ConeVolumes, s: VctSettings,
+def bounce(ctx, programs, albedo: FaceAlbedo, direct_faces: Faces, volumes: ConeVolumes, s: VctSettings,
            shared: VoxelGeometry | None = None) -> ConeVolumes:
     """bounces − 1 gathers at the voxel faces (vct/bounce.glsl), each followed by a re-mip. Returns the volumes
     the final gather reads (a non-owning view of `volumes` when bounces = 1); `bounce_stats` lists the flux the
@@ -40,7 +40,7 @@ def bounce(ctx, programs, vox, direct_faces: Faces, volumes: ConeVolumes, s: Vct
             previous = faces if b > 2 else direct_faces
             if b > 2:
                 faces = Faces([texture3d(ctx, grid.size, zero=True) for _ in range(6)], grid, direct_faces.levels)
-        prog = gather_program(programs, source, direct_faces, vox, s, pool)
+        prog = gather_program(programs, source, direct_faces, albedo, s, pool)
         for i, t in enumerate(faces.textures):
             t.bind_to_image(i, read=False, write=True)
         gather_listed(ctx, prog, listed, count, pool)
@@ -92,8 +92,10 @@ def face_list(ctx, programs, faces: Faces, capacity: int | None = None) -> tuple
     return listed, count
 
 
-def gather_program(programs, source: ConeVolumes, direct_faces: Faces, vox, s: VctSettings, pool=None):
-    """vct/bounce.glsl's gathers from `source`, bound (MODE_RECORD_GATHER / MODE_REPLAY_GATHER with a `pool`)."""
+def gather_program(programs, source: ConeVolumes, direct_faces: Faces, albedo: FaceAlbedo, s: VctSettings,
+                   pool=None):
+    """vct/bounce.glsl's gathers from `source`, each face reflecting with its `albedo`, bound (MODE_RECORD_GATHER /
+    MODE_REPLAY_GATHER with a `pool`)."""
     defines = {"MODE_ANISO": None} if source.anisotropic else {}
     if pool is not None:
         defines["MODE_REPLAY_GATHER" if pool.recorded else "MODE_RECORD_GATHER"] = None
@@ -101,7 +103,7 @@ def gather_program(programs, source: ConeVolumes, direct_faces: Faces, vox, s: V
     unit = bind_volumes(prog, source, 0)
     unit = bind_samplers(prog, "u_direct", direct_faces.textures, unit)
     unit = bind_samplers(prog, "u_centroid", direct_faces.centroids, unit)
-    bind_samplers(prog, "u_albedo", [vox.albedo], unit)
+    bind_samplers(prog, "u_albedo", albedo.textures, unit)
     bind_cones(prog, source.grid, min(source.levels, gather_levels(s.resolution)),
                replace(s, diffuse_cones=s.bounce_cones or s.diffuse_cones))
     return prog

@@ -1,7 +1,9 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""vct_inject: the direct light reflected through every voxel face. Surface points are rasterised along their
-dominant axis and lit exactly as the Diffuse Direct pass lights pixels (direct/eval.glsl), then averaged per face
-(Crassin et al. 2011 inject direct light from shadow maps into the voxels; here each voxel face is lit itself).
+"""vct_inject: the direct light arriving at every voxel face. Surface points are rasterised along their dominant
+axis and lit exactly as the Diffuse Direct pass lights pixels (direct/eval.glsl), then averaged per face (Crassin et
+al. 2011 inject direct light from shadow maps into the voxels; here each voxel face is lit itself). The faces'
+albedo is made apart from the same points (face_albedo), so a material's colour edit keeps the light; the radiance
+a face reflects is their product (vct/parts.sum_parts).
 Emission itself is never injected (emissive triangles are lights, so their light is in E already), and the light a
 closed emitter traps inside itself is left out (common/emitters.py: it would leak out through the voxels)."""
 from __future__ import annotations
@@ -15,7 +17,7 @@ from ..direct.geometry import POSITION_ONLY, POSITION_UV, draw_by_material
 from ..gl.bind import (VOLUME_GROUP, bind_grid, bind_lights, bind_samplers, dispatch, dispatch_counted, set_uniform,
                        set_uniforms, texture3d, zero_texture)
 from ..scene import Scene
-from .volumes import Faces, VoxelGeometry
+from .volumes import FaceAlbedo, Faces, VoxelGeometry
 
 
 INJECT_SAMPLES = 2  # raster samples per voxel edge: ~4 surface points per voxel face; slivers fall back (vct_inject)
@@ -24,9 +26,9 @@ COVER_TEST_BYTES = 256 * 2 ** 20  # the front-most images' budget (32 MiB at 64Â
 
 def inject(ctx, programs, scene: Scene, geometry, textures: list, vox, shadows, levels: int,
            shared: VoxelGeometry | None = None, scratch: dict | None = None) -> Faces:
-    """Direct light reflected through every voxel face: surface points rasterised along their dominant axis and lit
-    exactly as in direct/light.glsl (vct/inject_raster.glsl), then averaged per face (vct/inject.glsl). The faces'
-    centroids are taken from `shared` where it holds them, else made and left there. `scratch` (a dict; none: made
+    """Direct light arriving at every voxel face, E/Ï€ per unit albedo: surface points rasterised along their
+    dominant axis and lit exactly as in direct/light.glsl (vct/inject_raster.glsl), then averaged per face
+    (vct/inject.glsl); `faces.flux` is that light's (W per unit albedo). The faces' centroids are taken from `shared` where it holds them, else made and left there. `scratch` (a dict; none: made
     and released here) keeps the accumulator and the front-most surfaces for the next injection of the same voxels
     with other lights (vct/parts.py): the caller releases it (release_scratch)."""
     grid = vox.grid
@@ -82,12 +84,13 @@ def release_scratch(scratch: dict) -> None:
 
 def _raster_pass(ctx, programs, defines: dict, drawn: tuple, shadows, grid, scratch: dict) -> None:
     """vct/inject_raster.glsl in mode `defines` over every triangle of `drawn` = (scene, geometry, textures), into
-    the scratch's accumulator and front-most images."""
+    the scratch's accumulator and front-most images; lit by `shadows`' lights (None: MODE_ALBEDO, no light)."""
     side = max(grid.size) * INJECT_SAMPLES
     fronts = scratch["fronts"]
-    prog = programs.raster("vct/inject_raster.glsl", {**defines, **shadows.defines})
+    prog = programs.raster("vct/inject_raster.glsl", {**defines, **(shadows.defines if shadows else {})})
     bind_grid(prog, grid, 1)
-    bind_lights(prog, shadows, unit=2, sky_stride=SKY_INJECTION_STRIDE)
+    if shadows is not None:
+        bind_lights(prog, shadows, unit=2, sky_stride=SKY_INJECTION_STRIDE)
     set_uniforms(prog, {"u_samples": float(INJECT_SAMPLES), "u_viewport": (float(side), float(side)),
                         "u_cover_test": bool(fronts)})
     scratch["acc"].bind_to_image(0, read=True, write=True)
@@ -97,11 +100,37 @@ def _raster_pass(ctx, programs, defines: dict, drawn: tuple, shadows, grid, scra
     ctx.memory_barrier()
 
 
+def face_albedo(ctx, programs, scene: Scene, geometry, textures: list, vox) -> FaceAlbedo:
+    """Each voxel face's albedo: the mean over the surface points whose light the injection sends through it,
+    with the same weights and covered sides left out (vct/inject_raster.glsl MODE_ALBEDO, vct/face_albedo.glsl).
+    Made from the geometry and the materials alone: a light edit keeps it, a colour edit re-makes it alone."""
+    grid = vox.grid
+    out = FaceAlbedo([texture3d(ctx, grid.size, zero=True, dtype="f2") for _ in range(6)], grid)
+    scratch = {}
+    try:
+        acc = _accumulator(ctx, grid, scratch)
+        scratch["fronts"] = front_images(ctx, grid, max(grid.size) * INJECT_SAMPLES)
+        drawn = (scene, geometry, textures)
+        if scratch["fronts"]:
+            _raster_pass(ctx, programs, {"MODE_FRONT": None, "MODE_ALBEDO": None}, drawn, None, grid, scratch)
+        _raster_pass(ctx, programs, {"MODE_ALBEDO": None}, drawn, None, grid, scratch)
+        prog = programs.compute("vct/face_albedo.glsl")
+        unit = bind_samplers(prog, "u_area", [vox.area], 0)
+        bind_samplers(prog, "u_acc", [acc], unit)
+        set_uniform(prog, "u_grid_size", tuple(int(n) for n in grid.size))
+        for i, t in enumerate(out.textures):
+            t.bind_to_image(i, read=False, write=True)
+        dispatch(prog, grid.size)
+        ctx.memory_barrier()
+    finally:
+        release_scratch(scratch)
+    return out
+
+
 def _resolve_program(programs, defines: dict, vox, acc, shadows, grid, outputs):
     """vct/inject.glsl in mode `defines`, its volumes, lights, grid and output images bound."""
     prog = programs.compute("vct/inject.glsl", {**defines, **shadows.defines})
     unit = bind_samplers(prog, "u_area", [vox.area], 0)
-    unit = bind_samplers(prog, "u_albedo", [vox.albedo], unit)
     unit = bind_samplers(prog, "u_normal", [vox.normal], unit)
     unit = bind_samplers(prog, "u_acc", [acc], unit)
     bind_lights(prog, shadows, unit, sky_stride=SKY_INJECTION_STRIDE)

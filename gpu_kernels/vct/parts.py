@@ -18,7 +18,7 @@ light added or removed elsewhere, which moves the maps in the atlas, injects eve
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -27,7 +27,8 @@ from ..direct.shadows import emitter_records
 from ..gl.bind import bind_named, dispatch, set_uniform, texture3d
 from ..scene import Scene, hash_parts
 from .colours import largest_colour
-from .volumes import Faces
+from .inject import face_flux
+from .volumes import FaceAlbedo, Faces
 
 PARTS = ("lamps", "emitters", "sky")  # the pass of each is vct_inject_<name>
 PART_BYTES_CAP = 128 * 2 ** 20  # the parts' face volumes together (a part at 64³: 24 MiB)
@@ -73,9 +74,9 @@ def fits(grid, parts: int) -> bool:
 
 
 def parts_bytes(grid, parts: int) -> int:
-    """The memory the parts add on `grid`: their face volumes (six a part), where there is more than one part and
-    they fit (one part is the injection itself)."""
-    return parts * grid.voxel_count * FACE_BYTES if parts > 1 and fits(grid, parts) else 0
+    """The memory the parts add on `grid` to the faces they sum to: their face volumes (six a part), or where they
+    do not fit, those of the one injection of every light the sum is made from."""
+    return (parts if fits(grid, parts) else min(parts, 1)) * grid.voxel_count * FACE_BYTES
 
 
 def part_key(shadows, part: Part, records: np.ndarray) -> str:
@@ -84,15 +85,12 @@ def part_key(shadows, part: Part, records: np.ndarray) -> str:
     return hash_parts([shadows.light_keys[i] for i in part.lights], records["color_type"][:, :3])
 
 
-def sum_parts(ctx, programs, parts: list, weights: list, centroids: list) -> Faces:
-    """New faces Σ_p weights[p] ⊙ parts[p] (rgb; the coverage α, the geometry's, from any part), with the kept
-    `centroids` (not owned); their flux the parts' summed alike (the faces the parts lit at their centre and the
-    occupied voxels are the geometry's). One part of weight 1 (it is every light) is taken as it is: a view."""
+def sum_parts(ctx, programs, parts: list, weights: list, albedo: FaceAlbedo, centroids: list) -> Faces:
+    """New faces albedo ⊙ Σ_p weights[p] ⊙ parts[p] (rgb: each part's light per unit albedo; the coverage α, the
+    geometry's, from any part), with the kept `centroids` (not owned), and their flux (the faces the parts lit at
+    their centre and the occupied voxels are the geometry's)."""
     first = parts[0]
-    if len(parts) == 1 and np.all(np.asarray(weights[0]) == 1.0):
-        return replace(first, owned=False, centroids_owned=False)
     out = Faces([texture3d(ctx, first.grid.size, zero=True) for _ in range(6)], first.grid, first.levels,
-                flux=[float(sum(float(w[c]) * p.flux[c] for p, w in zip(parts, weights))) for c in range(3)],
                 occupied=first.occupied, centroids=centroids, missed=first.missed, centroids_owned=False)
     prog = programs.compute("vct/inject_sum.glsl")
     set_uniform(prog, "u_grid_size", tuple(int(n) for n in first.grid.size))
@@ -101,8 +99,10 @@ def sum_parts(ctx, programs, parts: list, weights: list, centroids: list) -> Fac
         set_uniform(prog, f"u_weight{p}", tuple(float(c) for c in w))
     for i, texture in enumerate(out.textures):
         faces = [f.textures[i] for f in parts]
-        bind_named(prog, [(f"u_part{p}", faces[min(p, len(faces) - 1)]) for p in range(len(PARTS))])
+        bind_named(prog, [(f"u_part{p}", faces[min(p, len(faces) - 1)]) for p in range(len(PARTS))]
+                   + [("u_albedo", albedo.textures[i])])
         texture.bind_to_image(0, read=False, write=True)
         dispatch(prog, first.grid.size)
     ctx.memory_barrier()
+    out.flux = face_flux(ctx, programs, out)[0]
     return out

@@ -1,16 +1,17 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """The VCT's passes in the pipeline's pass cache (pipeline.METHOD_PASSES["vct"]):
 
-    vct_voxelize    ← geometry, materials, grid
+    vct_voxelize    ← geometry, grid: the surfaces' areas and normals
+    vct_albedo      ← voxels, materials: each voxel face's albedo (vct/inject.face_albedo), apart from its light
     vct_geometry    ← geometry, emission, grid, levels: what the passes below derive from the geometry alone, made
                       by the first that needs each part and kept across light, world and material colour edits
                       (volumes.VoxelGeometry)
     vct_inject_lamps, _emitters, _sky
-                    ← voxels, that part's lights' shadow maps and records per unit of its largest colour
-                      (vct/parts.py); every light at once in vct_inject instead where several parts' volumes would
-                      not fit
-    vct_inject      ← the parts and their weights, summed (one part: its faces, a view); or voxels, shadow maps and
-                      the lights per unit of the largest colour (vct/colours.py)
+                    ← voxels, that part's lights' shadow maps and records per unit of its largest colour: the light
+                      arriving at each face per unit albedo (vct/parts.py); every light at once in vct_inject
+                      instead where several parts' volumes would not fit
+    vct_inject      ← the parts and their weights, summed and multiplied by the faces' albedo; or voxels, shadow
+                      maps, the lights per unit of the largest colour (vct/colours.py) and the albedo
     vct_mipmap      ← injection, anisotropy
     vct_bounce      ← mipmaps, cone settings, bounces
     vct_specular    ← gbuffer, bounced volumes, specular settings
@@ -34,7 +35,7 @@ from .volumes import VoxelGeometry, mip_levels, vct_grid, voxelize_scene
 
 # Outputs kept per pass (gl/pass_cache.py): the voxels, what their geometry decides and the per-pixel hits of two
 # grids and G-buffers (the live viewport's draft and final stages, which alternate after every edit).
-KEEP = {"vct_voxelize": 2, "vct_geometry": 2, "vct_hits": 2}
+KEEP = {"vct_voxelize": 2, "vct_albedo": 2, "vct_geometry": 2, "vct_hits": 2}
 
 
 def run(frame) -> MethodOutput:
@@ -43,21 +44,24 @@ def run(frame) -> MethodOutput:
     ctx, programs, cache, scene, s = frame.ctx, frame.programs, frame.cache, frame.scene, frame.settings.vct
     grid = vct_grid(scene, s)
     levels = mip_levels(s.resolution)
-    k_vox = (frame.keys["geometry"], frame.keys["materials"], grid.key())
+    k_vox = (frame.keys["geometry"], grid.key())
     vox = cache.run("vct_voxelize", k_vox,
                     lambda: voxelize_scene(ctx, programs, scene, frame.geometry, frame.textures, grid))
+    k_albedo = (k_vox, frame.keys["materials"])
+    albedo = cache.run("vct_albedo", k_albedo, lambda: inject.face_albedo(ctx, programs, scene, frame.geometry,
+                                                                          frame.textures, vox))
     # The lights per unit of the largest colour (vct/colours.py): an edit scaling every light alike keeps all that
     # follows, and only the results are scaled back.
     scale = colours.colour_scale(frame.shadows)
     shared = cache.run("vct_geometry", (frame.keys["geometry"], frame.keys["emission"], grid.key(), levels),
                        VoxelGeometry)
-    faces, k_inject = _inject(frame, vox, shared, (k_vox, levels), scale)
+    faces, k_inject = _inject(frame, vox, shared, (k_vox, levels, albedo, k_albedo), scale)
     k_mip = (k_inject, s.anisotropic)
     volumes = cache.run("vct_mipmap", k_mip, lambda: mipmap.build_volumes(ctx, programs, faces, s.anisotropic,
                                                                          shared=shared))
     k_bounce = (k_mip, s.key("bounce"))
     bounced = cache.run("vct_bounce", k_bounce,
-                        lambda: bounce.bounce(ctx, programs, vox, faces, volumes, s, shared))
+                        lambda: bounce.bounce(ctx, programs, albedo, faces, volumes, s, shared))
     k_spec = (frame.keys["gbuffer"], k_bounce, s.key("specular"))
     glossy = cache.run("vct_specular", k_spec, lambda: specular.specular(ctx, programs, frame.gbuffer, faces,
                                                                          bounced, s))
@@ -75,24 +79,28 @@ def run(frame) -> MethodOutput:
 
 def _inject(frame, vox, shared, base: tuple, scale: np.ndarray) -> tuple:
     """vct_inject: each part of the lights (the lamps, the emissive meshes, the sky) injected in its own pass per unit
-    of its colour and summed with weights (vct/parts.py; one part is taken as it is), or, where the parts' volumes
-    would not fit, every light at once per unit of `scale`. `base` = (the voxels' key, levels). Returns the faces
-    and their key."""
+    of its colour and albedo, summed with weights and multiplied by the faces' albedo (vct/parts.py), or, where the
+    parts' volumes would not fit, every light at once per unit of `scale`, multiplied alike. `base` = (the voxels'
+    key, levels, the faces' albedo, its key). Returns the faces and their key."""
     ctx, programs, cache, shadows = frame.ctx, frame.programs, frame.cache, frame.shadows
-    k_vox, levels = base
+    k_vox, levels, albedo, k_albedo = base
     scratch = {}  # the accumulator and front-most surfaces, shared by the parts injected in this frame
 
     def injected(subset):
         return colours.with_records(ctx, shadows, subset, lambda sh: inject.inject(
             ctx, programs, frame.scene, frame.geometry, frame.textures, vox, sh, levels, shared, scratch))
 
+    def reflected(made, weights):
+        return parts.sum_parts(ctx, programs, made, weights, albedo, shared.centroids)
+
     light_parts = parts.light_parts(shadows)
     try:
         if not light_parts or not parts.fits(vox.grid, len(light_parts)):
             cache.drop([f"vct_inject_{name}" for name in parts.PARTS])
             records = colours.unit_records(shadows, scale)
-            k_inject = (k_vox, colours.unit_key(shadows, records), levels)
-            return cache.run("vct_inject", k_inject, lambda: injected(records)), k_inject
+            k_inject = (k_vox, colours.unit_key(shadows, records), levels, k_albedo)
+            return cache.run("vct_inject", k_inject, lambda: _released_after(
+                injected(records), lambda light: reflected([light], [np.ones(3, np.float32)]))), k_inject
         made, keys = [], []
         for part in light_parts:
             subset = colours.unit_records(shadows, part.scale, part.lights)
@@ -103,9 +111,16 @@ def _inject(frame, vox, shared, base: tuple, scale: np.ndarray) -> tuple:
         inject.release_scratch(scratch)
     cache.drop([f"vct_inject_{name}" for name in set(parts.PARTS) - {p.name for p in light_parts}])
     weights = [part.scale / scale for part in light_parts]
-    k_inject = (tuple(keys), np.asarray(weights, np.float32).tobytes())
-    return cache.run("vct_inject", k_inject, lambda: parts.sum_parts(ctx, programs, made, weights,
-                                                                       shared.centroids)), k_inject
+    k_inject = (tuple(keys), np.asarray(weights, np.float32).tobytes(), k_albedo)
+    return cache.run("vct_inject", k_inject, lambda: reflected(made, weights)), k_inject
+
+
+def _released_after(faces, use):
+    """use(faces), then faces released."""
+    try:
+        return use(faces)
+    finally:
+        faces.release()
 
 
 def _per_pixel(frame, faces, bounced, base, grid):

@@ -52,9 +52,22 @@ def level_sizes(grid: Grid, levels: int) -> list[tuple]:
 
 
 @dataclass
+class FaceAlbedo:
+    """Six RGBA16F 3D textures, one per voxel face (as Faces): rgb = the albedo of the surfaces whose light leaves
+    through that face (vct/inject.face_albedo), 0 where there are none."""
+    textures: list
+    grid: Grid
+
+    def release(self):
+        for t in self.textures:
+            t.release()
+
+
+@dataclass
 class Faces:
     """Six RGBA32F 3D textures, one per voxel face (outward normal +x, −x, +y, −y, +z, −z): rgb = outgoing
-    radiance through that face, a = its coverage α_g (vct/inject.glsl). `flux`: π·cell²·Σ α_g·L_g (W, RGB)."""
+    radiance through that face (vct/inject.py's own: E/π, the light per unit albedo), a = its coverage α_g
+    (vct/inject.glsl). `flux`: π·cell²·Σ α_g·L_g (W, RGB)."""
     textures: list
     grid: Grid
     levels: int  # mip levels the volumes built from these faces get
@@ -63,10 +76,9 @@ class Faces:
     centroids: list = None  # vct/inject.py only: per face, xyz = where its surface points lie, w = ±α_g
     missed: int = 0  # faces with coverage that caught no raster sample (lit at the face centre instead)
     centroids_owned: bool = True  # False: VoxelGeometry's, kept across light edits
-    owned: bool = True  # False: a view of another pass's faces (vct_inject of a scene with one part, vct/parts.py)
 
     def release(self):
-        for t in (self.textures if self.owned else []) + (self.centroids or [] if self.centroids_owned else []):
+        for t in self.textures + (self.centroids or [] if self.centroids_owned else []):
             t.release()
 
 
@@ -126,7 +138,13 @@ def bind_volumes(prog, volumes: ConeVolumes, first: int) -> int:
 
 
 def voxelize_scene(ctx, programs, scene: Scene, geometry, textures: list, grid: Grid):
-    """The shared voxelizer (rasterised, exact areas) on the VCT grid."""
+    """The shared voxelizer (rasterised, exact areas) on the VCT grid: the surfaces' areas and normals, what the
+    geometry alone decides. Its albedo and emission volumes are released (None): the VCT takes each face's albedo
+    from vct/inject.face_albedo and its emitters' light from the lights, so a material edit keeps these voxels."""
     from ..voxel.voxelize import voxelize
 
-    return voxelize(ctx, programs, scene, geometry, textures, grid)
+    vox = voxelize(ctx, programs, scene, geometry, textures, grid)
+    for name in ("albedo", "emission"):
+        getattr(vox, name).release()
+        setattr(vox, name, None)
+    return vox

@@ -48,6 +48,7 @@ class VoxelVolumes:
     emission: rgb = area-weighted mean emitted radiance;
     albedo_back (sides=True): rgb = the back side's mean albedo (the side opposite the mean normal), albedo's rgb
     then the front side's; None where not asked for or over SIDES_BYTES (one albedo serves both sides).
+    A caller that reads no albedo or emission may release those and leave None (vct/volumes.voxelize_scene).
     """
     grid: Grid
     area: object
@@ -66,11 +67,8 @@ class VoxelVolumes:
     extent_hi: object = None
 
     def textures(self) -> dict:
-        out = {name: getattr(self, name) for name in VOLUME_NAMES}
-        for name in ("albedo_back", "position", "extent_lo", "extent_hi"):
-            if getattr(self, name) is not None:
-                out[name] = getattr(self, name)
-        return out
+        names = VOLUME_NAMES + ("albedo_back", "position", "extent_lo", "extent_hi")
+        return {name: getattr(self, name) for name in names if getattr(self, name) is not None}
 
     def read(self, names=None) -> dict:
         """{name: (nz, ny, nx, 4) float32} of every volume, or of those in `names` that exist — call on the GL

@@ -2,7 +2,7 @@
 // VCT multiple bounces (Freed 2018 traces cones from pixels only; gathering at the voxels too is the same estimator
 // applied to the voxel faces): each occupied voxel face g gathers the irradiance E_g arriving over the hemisphere
 // of its outward normal from the current radiance volumes (vct/common.glsl), and its outgoing radiance becomes
-//   L_g = L_direct,g + albedo · E_g / π
+//   L_g = L_direct,g + albedo_g · E_g / π   (albedo_g the face's, vct/face_albedo.glsl)
 // (Jacobi iteration: after k passes the volumes hold light reflected up to k + 1 times). The cones start from the
 // face's surface centroid (vct/inject.glsl: the mean of the surface points whose light leaves through that face),
 // so an edge voxel's wall face gathers from the wall inside the room, not from under the floor crossing its
@@ -40,7 +40,8 @@ layout(local_size_x = 64) in;
 layout(std430, binding = 5) readonly buffer FaceList { ivec4 faces[]; };
 uniform int u_face_first;   // this dispatch's first face (at most 65535 groups a dispatch)
 uniform int u_face_count;   // faces in the list
-uniform sampler3D u_albedo;
+uniform sampler3D u_albedo[6];   // vct/face_albedo.glsl: each face's albedo
+VCT_FETCH6(face_albedo, u_albedo)
 layout(rgba32f, binding = 0) uniform writeonly image3D u_face[6];
 VCT_STORE6(store_face, u_face)
 
@@ -95,7 +96,7 @@ void main() {   // the faces without coverage keep the zeros their images start 
     ivec3 v = faces[i].xyz;
     int g = faces[i].w;
     vec4 direct = direct_face(g, v, 0);
-    vec3 albedo = texelFetch(u_albedo, v, 0).rgb;
+    vec3 albedo = face_albedo(g, v, 0).rgb;
     vec3 radiance = direct.rgb;
     if (max(albedo.r, max(albedo.g, albedo.b)) > 0.0) radiance += albedo * face_irradiance(i, v, g) / VCT_PI;
     store_face(g, v, vec4(radiance, direct.a));

@@ -3,21 +3,22 @@
 //
 // Per direction, not per side of the voxel normal: the voxelizer's normal is a mean of sign-canonicalised normals,
 // which says nothing about which side faces a room at an edge or corner voxel (floor + wall average to a diagonal
-// pointing into neither). So each of the six faces of a voxel (outward normal ±x, ±y, ±z) gets its own radiance
+// pointing into neither). So each of the six faces of a voxel (outward normal ±x, ±y, ±z) gets its own light
 // and coverage:
-//   L_g = Σ w·L / Σ w over the surface points whose lit side points through face g (vct/inject_raster.glsl),
+//   E_g/π = Σ w·E/π / Σ w over the surface points whose lit side points through face g (vct/inject_raster.glsl;
+//         the face's radiance is albedo_g ⊙ E_g/π, its albedo made apart, vct/face_albedo.glsl),
 //   α_g = min(1, projected area onto the face's plane / cell²) from the voxelizer (the opacity of crossing the voxel
 //         along that axis; the same for both faces of an axis), a tilted plane's column summed (column_area),
 //   c_g = Σ w·p / Σ w, where those surface points lie (the bounce pass gathers from there).
 // A face that has coverage but caught no fragment (a sliver thinner than the raster's pixels) falls back to one
-// evaluation at the face centre with the face normal: L_g = albedo·E(centre + n_g·cell/2, n_g)/π. The resolve lists
+// evaluation at the face centre with the face normal: E(centre + n_g·cell/2, n_g)/π. The resolve lists
 // those faces and MODE_FALLBACK lights them, one per invocation: lit in the resolve, every voxel of a SIMD group paid
 // for the group's few fallback faces, up to six times over (measured, the Cornell box's 3244 of them: 190 ms of
 // resolve, 35 without the lighting).
 // Emission is not injected: emissive triangles are lights (common/lights.py), so E already carries their light,
 // and adding it again would count it twice (Cycles' Diffuse Indirect never holds emission). A closed emitter emits
 // outwards only (common/emitters.py): its inner light would leak out of the voxels.
-// The accumulator starts zeroed (gl/bind.zero_texture). MODE_RESOLVE writes the faces: rgb = L_g, a = α_g, and
+// The accumulator starts zeroed (gl/bind.zero_texture). MODE_RESOLVE writes the faces: rgb = E_g/π, a = α_g, and
 // centroids: xyz = c_g, w = α_g (or the face centre and w = −α_g for a fallback face; w = 0 where the voxel has no
 // surface); MODE_FALLBACK lights the fallback faces the resolve listed.
 #if !defined(MODE_FALLBACK)
@@ -33,7 +34,6 @@ uniform vec3 u_grid_origin;
 uniform float u_grid_cell;
 uniform int u_light_count;
 uniform sampler3D u_area;        // voxelize(): rgb projected areas (m²), a total area
-uniform sampler3D u_albedo;      // rgb mean albedo (voxel/common.glsl voxel_albedo)
 uniform sampler3D u_normal;      // xyz area-weighted mean canonical normal (voxel/voxelize.py)
 uniform usampler3D u_acc;        // vct/inject_raster.glsl's sums (float bits)
 // Six images per dispatch, not twelve: NVIDIA drivers allow 8 image units per stage (GL_MAX_IMAGE_UNITS, the
@@ -71,7 +71,7 @@ void main() {
     vec3 p = face_point(v, n);
     vec3 e = vec3(0.0);
     for (int k = 0; k < u_light_count; ++k) e += light_irradiance(lights[k], p, n, n);
-    store_out(g, v, vec4(texelFetch(u_albedo, v, 0).rgb * e / PI, uintBitsToFloat(f.z)));
+    store_out(g, v, vec4(e / PI, uintBitsToFloat(f.z)));
 }
 #else
 layout(std430, binding = 3) buffer Count { uint fallback_count; };   // gl/bind.dispatch_counted
@@ -121,7 +121,7 @@ void main() {
         int axis = g >> 1;
         vec3 n = face_normal(g);
         float alpha = min(1.0, column_area(v, axis, area[axis]) / cell2);
-        vec3 radiance = vec3(0.0);
+        vec3 radiance = vec3(0.0);   // E_g/π
         vec4 surface = vec4(face_point(v, n), 0.0);
         float w = acc(g, v, 3);
         if (alpha > 0.0 && w > 0.0) {

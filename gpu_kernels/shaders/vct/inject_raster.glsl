@@ -4,16 +4,18 @@
 //
 // Geometry shader: each triangle is projected along the dominant axis of its normal (Freed 2018, §4.1.1, Algorithm 1)
 // onto a plane of VCT_SAMPLES pixels per voxel edge; every fragment is a point p on the surface, with the
-// triangle's geometric normal n and its material's albedo as the voxelizer defines it (voxel/common.glsl
-// voxel_albedo: the diffuse and glossy layers' reflectance averaged over directions).
-// Fragment shader: for each side s = ±n the outgoing radiance L_s = albedo·E(p, s·n)/π, E the shadowed irradiance
-// of every light exactly as the Diffuse Direct pass computes it (direct/eval.glsl; closed emitters emit outwards
-// only, common/emitters.py). The side's light leaves the
-// voxel through the faces its normal points to: face g = (axis b, sign of s·n_b) receives weight
-// w = A·|n_b| (the fragment's area A projected onto that face's plane) and adds w·L_s, w and w·p to the face's
+// triangle's geometric normal n.
+// Fragment shader: for each side s = ±n the irradiance E_s = E(p, s·n) of every light exactly as the Diffuse Direct
+// pass computes it (direct/eval.glsl; closed emitters emit outwards only, common/emitters.py). The side's light
+// leaves the voxel through the faces its normal points to: face g = (axis b, sign of s·n_b) receives weight
+// w = A·|n_b| (the fragment's area A projected onto that face's plane) and adds w·E_s/π, w and w·p to the face's
 // accumulator (vct/inject.glsl resolves the means). So a voxel holding a floor and a wall (an edge) gets the lit
-// wall's radiance on its ±x faces and the floor's on its ±z faces, wherever their surfaces lie in the voxel — the
+// wall's light on its ±x faces and the floor's on its ±z faces, wherever their surfaces lie in the voxel — the
 // voxel's mean normal could not say which side of such a voxel faces the room.
+// MODE_ALBEDO adds w·albedo and w instead, for the same points and weights (the material's albedo as the voxelizer
+// defines it, voxel/common.glsl voxel_albedo: the diffuse and glossy layers' reflectance averaged over directions):
+// the face's albedo, kept apart from its light so that a material's colour edit changes the one and not the other
+// (vct/face_albedo.glsl; the face's radiance is albedo_g ⊙ E_g/π, vct/inject_sum.glsl).
 // Covered surfaces: a surface with another one in front of it in the same raster column of the same voxel (the
 // floor under a rug lying 1 mm above it, a wall behind a poster) is hidden from that side and leaves the face of
 // that side alone, so the visible surface's colour is the face's. A first pass (MODE_FRONT) keeps, per column,
@@ -72,13 +74,15 @@ void main() {
 #endif
 
 #if defined(FRAGMENT_SHADER)
+#if !defined(MODE_ALBEDO)
 #include "common/lights.glsl"
 #include "common/light_eval.glsl"
 #include "direct/eval.glsl"
+uniform int u_light_count;
+#endif
 uniform vec3 u_grid_origin;
 uniform float u_grid_cell;
 uniform ivec3 u_grid_size;
-uniform int u_light_count;
 uniform vec3 u_base_color;
 uniform vec3 u_albedo_scale;      // common/principled.py: transport_albedo, albedo = base ⊙ scale + offset
 uniform vec3 u_albedo_offset;
@@ -96,7 +100,8 @@ layout(r32ui, binding = 1) coherent uniform uimage3D u_front_x;
 layout(r32ui, binding = 2) coherent uniform uimage3D u_front_y;
 layout(r32ui, binding = 3) coherent uniform uimage3D u_front_z;
 #define FRONT_TOLERANCE 66u         // 1/1000 of a cell: coplanar pieces (shared edges, duplicates) all count
-// Accumulator: channel c (0–2 Σw·L, 3 Σw, 4–6 Σw·p) of face g of voxel v at (8·v.x + c, v.y, g·nz + v.z).
+// Accumulator: channel c (0–2 Σw·E/π or, MODE_ALBEDO, Σw·albedo; 3 Σw; 4–6 Σw·p) of face g of voxel v at
+// (8·v.x + c, v.y, g·nz + v.z).
 layout(r32ui, binding = 0) coherent uniform uimage3D u_acc;
 
 void add_float(ivec3 t, float x) {
@@ -129,6 +134,30 @@ void front_max(ivec3 t, uint d) {
     else imageAtomicMax(u_front_z, t, d);
 }
 
+// Adds w·value, w (and, lighting, w·p) to each face of voxel v that the side with normal n leaves through, unless
+// a surface in front of p in its raster column covers that side.
+void deposit(vec3 p, ivec3 v, vec3 n, vec3 value) {
+    for (int b = 0; b < 3; ++b) {
+        float w = g_area * abs(n[b]);
+        if (w <= 0.0) continue;
+        if (u_cover_test && b == g_axis) {
+            int s = n[b] > 0.0 ? 0 : 1;
+            if (front_depth(p, v, s) + FRONT_TOLERANCE < front_load(front_texel(v, s))) continue;  // covered
+        }
+        int g = 2 * b + (n[b] > 0.0 ? 0 : 1);
+        ivec3 t = ivec3(8 * v.x, v.y, g * u_grid_size.z + v.z);
+        add_float(t, w * value.r);
+        add_float(t + ivec3(1, 0, 0), w * value.g);
+        add_float(t + ivec3(2, 0, 0), w * value.b);
+        add_float(t + ivec3(3, 0, 0), w);
+#if !defined(MODE_ALBEDO)
+        add_float(t + ivec3(4, 0, 0), w * p.x);
+        add_float(t + ivec3(5, 0, 0), w * p.y);
+        add_float(t + ivec3(6, 0, 0), w * p.z);
+#endif
+    }
+}
+
 void main() {
     vec3 p = g_world;
     ivec3 v = ivec3(floor((p - u_grid_origin) / u_grid_cell));
@@ -138,39 +167,24 @@ void main() {
     front_max(front_texel(v, 1), front_depth(p, v, 1));
     return;
 #endif
+#if defined(MODE_ALBEDO)
     vec3 color = u_use_texture ? textureLod(u_base_texture, g_uv, 0.0).rgb : u_base_color;
     vec3 albedo = max(color, vec3(0.0)) * u_albedo_scale + u_albedo_offset;
+    deposit(p, v, g_normal, albedo);
+    deposit(p, v, -g_normal, albedo);
+#else
     // Both sides lit in one pass over the lights (light_unshadowed_sides: an emissive mesh's triangles once for the
     // two), each side's irradiance summed over the lights in their order as light_irradiance would.
     vec3 lit[2] = vec3[2](vec3(0.0), vec3(0.0));
-    if (max(albedo.r, max(albedo.g, albedo.b)) > 0.0)
-        for (int i = 0; i < u_light_count; ++i) {
-            vec3 back, front = light_unshadowed_sides(lights[i], p, g_normal, back);
-            if (max(front.r, max(front.g, front.b)) > 0.0)
-                lit[0] += front * light_visibility(lights[i], p, g_normal, g_normal);
-            if (max(back.r, max(back.g, back.b)) > 0.0)
-                lit[1] += back * light_visibility(lights[i], p, -g_normal, -g_normal);
-        }
-    for (int side = 0; side < 2; ++side) {
-        vec3 n = side == 0 ? g_normal : -g_normal;
-        vec3 radiance = albedo * lit[side] / PI;
-        for (int b = 0; b < 3; ++b) {
-            float w = g_area * abs(n[b]);
-            if (w <= 0.0) continue;
-            if (u_cover_test && b == g_axis) {
-                int s = n[b] > 0.0 ? 0 : 1;
-                if (front_depth(p, v, s) + FRONT_TOLERANCE < front_load(front_texel(v, s))) continue;  // covered
-            }
-            int g = 2 * b + (n[b] > 0.0 ? 0 : 1);
-            ivec3 t = ivec3(8 * v.x, v.y, g * u_grid_size.z + v.z);
-            add_float(t, w * radiance.r);
-            add_float(t + ivec3(1, 0, 0), w * radiance.g);
-            add_float(t + ivec3(2, 0, 0), w * radiance.b);
-            add_float(t + ivec3(3, 0, 0), w);
-            add_float(t + ivec3(4, 0, 0), w * p.x);
-            add_float(t + ivec3(5, 0, 0), w * p.y);
-            add_float(t + ivec3(6, 0, 0), w * p.z);
-        }
+    for (int i = 0; i < u_light_count; ++i) {
+        vec3 back, front = light_unshadowed_sides(lights[i], p, g_normal, back);
+        if (max(front.r, max(front.g, front.b)) > 0.0)
+            lit[0] += front * light_visibility(lights[i], p, g_normal, g_normal);
+        if (max(back.r, max(back.g, back.b)) > 0.0)
+            lit[1] += back * light_visibility(lights[i], p, -g_normal, -g_normal);
     }
+    deposit(p, v, g_normal, lit[0] / PI);
+    deposit(p, v, -g_normal, lit[1] / PI);
+#endif
 }
 #endif
