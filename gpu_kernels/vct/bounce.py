@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """vct_bounce: bounces − 1 gathers at the voxel faces, each followed by a re-mip, and the rest of the bounces
-extrapolated as a geometric series (common/bounce_tail.py)."""
+extrapolated as a geometric series (common/bounce_tail.py), re-mipped once after it (not also after the last
+gather: no cone reads those volumes)."""
 from __future__ import annotations
 
 from dataclasses import replace
@@ -19,7 +20,8 @@ from .volumes import ConeVolumes, FaceAlbedo, Faces, VoxelGeometry, bind_volumes
 
 def bounce(ctx, programs, albedo: FaceAlbedo, direct_faces: Faces, volumes: ConeVolumes, s: VctSettings,
            shared: VoxelGeometry | None = None) -> ConeVolumes:
-    """bounces − 1 gathers at the voxel faces (vct/bounce.glsl), each followed by a re-mip. Returns the volumes
+    """bounces − 1 gathers at the voxel faces (vct/bounce.glsl), each followed by a re-mip (where a tail follows the
+    last gather, after the tail instead). Returns the volumes
     the final gather reads (a non-owning view of `volumes` when bounces = 1); `bounce_stats` lists the flux the
     faces carry after each bounce (bounce 1 = direct light reflected once). The list of faces to gather is taken
     from `shared` where it holds one, else made and left there."""
@@ -44,9 +46,11 @@ def bounce(ctx, programs, albedo: FaceAlbedo, direct_faces: Faces, volumes: Cone
         for i, t in enumerate(faces.textures):
             t.bind_to_image(i, read=False, write=True)
         gather_listed(ctx, prog, listed, count, pool)
-        own = source = build_volumes(ctx, programs, faces, volumes.anisotropic, into=own, layers=volumes.layers)
         stats.append({"bounce": b, "flux": face_flux(ctx, programs, faces)[0]})
-        if _total(stats[-1]) - _total(stats[-2]) < s.epsilon * _total(stats[0]):
+        stopped = _total(stats[-1]) - _total(stats[-2]) < s.epsilon * _total(stats[0])
+        if stopped or b < gathered or gathered == s.bounces:  # else the tail follows, and the re-mip after it
+            own = source = build_volumes(ctx, programs, faces, volumes.anisotropic, into=own, layers=volumes.layers)
+        if stopped:
             stats[-1]["stopped"] = True  # the series ends here: no further gather, no tail
             break
     if shared is None:
