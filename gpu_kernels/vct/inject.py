@@ -63,13 +63,14 @@ def inject(ctx, programs, scene: Scene, geometry, textures: list, vox, shadows, 
     return faces
 
 
-def _accumulator(ctx, grid, scratch: dict):
-    """The raster's sums (vct/inject_raster.glsl), zeroed: `scratch`'s, or made and left there."""
+def _accumulator(ctx, grid, scratch: dict, channels: int = 8):
+    """The raster's sums (vct/inject_raster.glsl: `channels` a face, its ACC_CHANNELS), zeroed: `scratch`'s, or
+    made and left there."""
     import moderngl
 
     if "acc" not in scratch:
         nx, ny, nz = grid.size
-        scratch["acc"] = ctx.texture3d((8 * nx, ny, 6 * nz), 1, dtype="u4")
+        scratch["acc"] = ctx.texture3d((channels * nx, ny, 6 * nz), 1, dtype="u4")
         scratch["acc"].filter = (moderngl.NEAREST, moderngl.NEAREST)
     zero_texture(ctx, scratch["acc"])
     return scratch["acc"]
@@ -108,7 +109,7 @@ def face_albedo(ctx, programs, scene: Scene, geometry, textures: list, vox) -> F
     out = FaceAlbedo([texture3d(ctx, grid.size, zero=True, dtype="f2") for _ in range(6)], grid)
     scratch = {}
     try:
-        acc = _accumulator(ctx, grid, scratch)
+        acc = _accumulator(ctx, grid, scratch, channels=4)
         scratch["fronts"] = front_images(ctx, grid, max(grid.size) * INJECT_SAMPLES)
         drawn = (scene, geometry, textures)
         if scratch["fronts"]:

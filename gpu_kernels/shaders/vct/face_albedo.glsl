@@ -13,6 +13,7 @@ layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;  // gl/bind.VOL
 uniform ivec3 u_grid_size;
 uniform sampler3D u_area;        // voxelize(): rgb projected areas (m²), a total area
 uniform usampler3D u_acc;        // vct/inject_raster.glsl MODE_ALBEDO's sums (float bits)
+#define ACC_CHANNELS 4           // Σ w·albedo (rgb), Σ w: vct/inject_raster.glsl's in MODE_ALBEDO
 layout(rgba16f, binding = 0) uniform writeonly image3D u_out[6];       // +x, −x, +y, −y, +z, −z
 #include "vct/arrays.glsl"
 VCT_STORE6(store_out, u_out)
@@ -20,7 +21,7 @@ VCT_STORE6(store_out, u_out)
 float acc(ivec3 t) { return uintBitsToFloat(texelFetch(u_acc, t, 0).r); }
 
 vec4 sums(int g, ivec3 v) {   // (Σ w·albedo, Σ w) of face g of voxel v
-    ivec3 t = ivec3(8 * v.x, v.y, g * u_grid_size.z + v.z);
+    ivec3 t = ivec3(ACC_CHANNELS * v.x, v.y, g * u_grid_size.z + v.z);
     return vec4(acc(t), acc(t + ivec3(1, 0, 0)), acc(t + ivec3(2, 0, 0)), acc(t + ivec3(3, 0, 0)));
 }
 
@@ -38,10 +39,13 @@ void main() {
     if (any(greaterThanEqual(v, u_grid_size))) return;
     vec4 area = texelFetch(u_area, v, 0);
     if (area.a <= 0.0) return;   // the images start zeroed (gl/bind.texture3d)
-    vec4 own = vec4(0.0);
-    for (int g = 0; g < 6; ++g) own += sums(g, v);
+    vec4 face[6], own = vec4(0.0);
     for (int g = 0; g < 6; ++g) {
-        vec4 s = sums(g, v);
+        face[g] = sums(g, v);
+        own += face[g];
+    }
+    for (int g = 0; g < 6; ++g) {
+        vec4 s = face[g];
         if (s.w <= 0.0 && area[g >> 1] > 0.0) s = neighbours(g, v);
         if (s.w <= 0.0) s = own;
         store_out(g, v, vec4(s.w > 0.0 ? s.rgb / s.w : vec3(0.0), 1.0));

@@ -100,8 +100,13 @@ layout(r32ui, binding = 1) coherent uniform uimage3D u_front_x;
 layout(r32ui, binding = 2) coherent uniform uimage3D u_front_y;
 layout(r32ui, binding = 3) coherent uniform uimage3D u_front_z;
 #define FRONT_TOLERANCE 66u         // 1/1000 of a cell: coplanar pieces (shared edges, duplicates) all count
-// Accumulator: channel c (0–2 Σw·E/π or, MODE_ALBEDO, Σw·albedo; 3 Σw; 4–6 Σw·p) of face g of voxel v at
-// (8·v.x + c, v.y, g·nz + v.z).
+// Accumulator: channel c (0–2 Σw·E/π or, MODE_ALBEDO, Σw·albedo; 3 Σw; 4–6 Σw·p, not in MODE_ALBEDO) of face g of
+// voxel v at (ACC_CHANNELS·v.x + c, v.y, g·nz + v.z).
+#if defined(MODE_ALBEDO)
+#define ACC_CHANNELS 4
+#else
+#define ACC_CHANNELS 8
+#endif
 layout(r32ui, binding = 0) coherent uniform uimage3D u_acc;
 
 void add_float(ivec3 t, float x) {
@@ -145,7 +150,7 @@ void deposit(vec3 p, ivec3 v, vec3 n, vec3 value) {
             if (front_depth(p, v, s) + FRONT_TOLERANCE < front_load(front_texel(v, s))) continue;  // covered
         }
         int g = 2 * b + (n[b] > 0.0 ? 0 : 1);
-        ivec3 t = ivec3(8 * v.x, v.y, g * u_grid_size.z + v.z);
+        ivec3 t = ivec3(ACC_CHANNELS * v.x, v.y, g * u_grid_size.z + v.z);
         add_float(t, w * value.r);
         add_float(t + ivec3(1, 0, 0), w * value.g);
         add_float(t + ivec3(2, 0, 0), w * value.b);
