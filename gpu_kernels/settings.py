@@ -70,13 +70,14 @@ def method_bytes(scene: Scene, settings: RenderSettings) -> int:
     """About how many bytes of GPU memory the method's volumes take (0 for "none")."""
     if settings.method == "vct":
         from .vct.inject import front_bytes
+        from .vct.memory import traced_texels
         from .vct.parts import parts_bytes, scene_parts
         from .vct.replay import pool_bytes
         from .vct.volumes import vct_grid
         from .voxel.voxelize import scene_area
 
-        grid, scale = vct_grid(scene, settings.vct), settings.vct.indirect_scale
-        traced = (-(-settings.width // scale), -(-settings.height // scale))
+        grid = vct_grid(scene, settings.vct)
+        traced = traced_texels(settings.width, settings.height, settings.vct)
         return (grid.voxel_count * VCT_BYTES_PER_VOXEL + front_bytes(grid) + VCT_FIXED_BYTES
                 + pool_bytes(scene_area(scene), grid.cell, traced) + parts_bytes(grid, scene_parts(scene)))
     if settings.method == "lpv":

@@ -214,6 +214,21 @@ def transfer_memory(scene) -> list:
     return [transfer_estimate(scene, LpvSettings(resolution=n)) for n in MEMORY_RESOLUTIONS]
 
 
+def vct_memory(scene) -> list:
+    """What the VCT keeps across edits (vct/memory.py) at MEMORY_RESOLUTIONS, its defaults otherwise, the trace at the
+    scene's resolution."""
+    from dataclasses import replace
+
+    from ...gpu_kernels.vct.memory import cached_bytes, traced_texels
+    from ...gpu_kernels.vct.settings import VctSettings
+    from ...gpu_kernels.voxel.voxelize import scene_area
+
+    s, area = VctSettings(), scene_area(scene)
+    traced = traced_texels(*scene.resolution, s)
+    return [{"resolution": n, "bytes": cached_bytes(scene, replace(s, resolution=n), traced, area)}
+            for n in MEMORY_RESOLUTIONS]
+
+
 def run_incremental(path: str, res, methods, progress, repeats: int = 3) -> dict:
     import tempfile
 
@@ -226,6 +241,8 @@ def run_incremental(path: str, res, methods, progress, repeats: int = 3) -> dict
     with tempfile.TemporaryDirectory() as tmp:
         result["peers"] = {"cycles_1spp_oidn": time_cycles_1spp_oidn(tuple(scene.resolution), tmp, repeats)}
     result["lpv_transfer_memory"] = transfer_memory(scene)
+    if "vct" in methods:
+        result["vct_memory"] = vct_memory(scene)
     return result
 
 
@@ -273,4 +290,17 @@ def format_incremental(entry: dict) -> str:
                   "| grid | surface voxels | clusters | T (MiB) | transport |", "|---:|---:|---:|---:|---|"]
         lines += [f"| {m['resolution']}³ | {m['surface_voxels']} | {m['clusters']} | {m['mb']:.0f} | {m['transport']} |"
                   for m in memory]
-    return "\n".join(lines) + "\n"
+    return "\n".join(lines + vct_memory_table(entry.get("vct_memory"))) + "\n"
+
+
+def vct_memory_table(memory: list | None) -> list:
+    """Markdown lines: what the VCT keeps across edits, MiB per grid size (none without a measure)."""
+    if not memory:
+        return []
+    mib = 2.0 ** 20
+    lines = ["", "VCT kept across edits (GPU memory, MiB; the pools at their first size, vct/memory.py):", "",
+             "| structure | " + " | ".join(f"{m['resolution']}³" for m in memory) + " |",
+             "|---|" + "---:|" * len(memory)]
+    for name in memory[0]["bytes"]:
+        lines.append(f"| {name} | " + " | ".join(f"{m['bytes'][name] / mib:.1f}" for m in memory) + " |")
+    return lines + ["| total | " + " | ".join(f"{sum(m['bytes'].values()) / mib:.1f}" for m in memory) + " |"]

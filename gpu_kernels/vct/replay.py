@@ -99,11 +99,19 @@ FACES_PER_CELL_AREA = 2.5
 def pool_bytes(area: float, cell: float, traced: tuple) -> int:
     """About how many bytes the two pools take for a scene of `area` m² on a grid of `cell` m and a trace of `traced`
     = (w, h) texels (settings.method_bytes): each at its first size, within BUDGET_BYTES."""
+    return hits_bytes(traced) + steps_bytes(area, cell)
+
+
+def hits_bytes(traced: tuple) -> int:
+    """The per-pixel trace's pool for `traced` = (w, h) texels at its first size, within BUDGET_BYTES."""
     texels = int(traced[0]) * int(traced[1])
+    return int(min(HEADER_BYTES * texels + CHUNKS_PER_TEXEL * texels * chunk_bytes(TRACE_SLOTS), BUDGET_BYTES))
+
+
+def steps_bytes(area: float, cell: float) -> int:
+    """The bounce gathers' pool for `area` m² of surface on a grid of `cell` m, within BUDGET_BYTES."""
     faces = FACES_PER_CELL_AREA * area / cell ** 2
-    hits = HEADER_BYTES * texels + CHUNKS_PER_TEXEL * texels * chunk_bytes(TRACE_SLOTS)
-    steps = faces * (HEADER_BYTES + CHUNKS_PER_FACE * chunk_bytes(GATHER_SLOTS))
-    return int(min(hits, BUDGET_BYTES) + min(steps, BUDGET_BYTES))
+    return int(min(faces * (HEADER_BYTES + CHUNKS_PER_FACE * chunk_bytes(GATHER_SLOTS)), BUDGET_BYTES))
 
 
 @contextmanager
