@@ -167,8 +167,8 @@ def zero_texture(ctx, texture) -> None:
 
 
 def texture3d(ctx, size, levels: int = 1, zero: bool = False, dtype: str = "f4"):
-    """An RGBA32F volume (RGBA16F with dtype "f2"); `zero`: filled with zeros, so passes may skip storing to empty voxels (llvmpipe image
-    stores are slow: storing 12 zeros to every empty voxel took 1 s of vct_inject at 128³)."""
+    """An RGBA32F volume (RGBA16F with dtype "f2"); `zero`: filled with zeros, so passes may skip storing to empty
+    voxels (llvmpipe image stores are slow: storing 12 zeros to every empty voxel took 1 s of vct_inject at 128³)."""
     import moderngl
 
     t = ctx.texture3d(tuple(int(n) for n in size), 4, None, dtype=dtype)

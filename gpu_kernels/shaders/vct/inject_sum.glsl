@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // vct_inject by parts (vct/parts.py): one face volume of the radiance L_g = albedo_g ⊙ Σ_p k_p ⊙ E_g,p/π, where part p
 // was injected per unit of its own colour and k_p scales it back (per channel, relative to the transport's unit,
-// vct/colours.py), summed in the parts' order, and albedo_g is the face's (vct/face_albedo.glsl). The coverage α_g is the geometry's, the same in every part. Run once per face
-// direction; the sum starts zeroed (gl/bind.texture3d), so voxels without surfaces are left alone. The parts'
-// samplers are read by name, not from an array indexed in a loop (vct/arrays.glsl: Mesa 22 got such reads wrong).
+// vct/colours.py), summed in the parts' order, and albedo_g is the face's (vct/face_albedo.glsl). The coverage α_g
+// is the geometry's, the same in every part. Run once per face direction; the sum starts zeroed
+// (gl/bind.texture3d), so voxels without surfaces are left alone. The parts' samplers are read by name, not from an
+// array indexed in a loop (vct/arrays.glsl: Mesa 22 got such reads wrong).
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;  // gl/bind.VOLUME_GROUP
 uniform sampler3D u_part0, u_part1, u_part2;                     // this face of each part (vct/parts.PARTS)
 uniform sampler3D u_albedo;                                      // this face's albedo
