@@ -13,12 +13,12 @@ def build_volumes(ctx, programs, faces: Faces, anisotropic: bool, into: ConeVolu
     """Level 0 from the face radiances, then each level from the one below (vct/mipmap.glsl, Freed 2018, §4.4), and,
     anisotropic, the layer volume (from faces.centroids, or `layers` shared from the volumes of the same geometry,
     or `shared`'s, which gets it where it has none). `into`: rebuild existing volumes in place (the vct_bounce pass)
-    instead of allocating new ones."""
+    instead of allocating new ones — volumes built from faces of the same coverage, whose empty voxels hold zeros."""
     grid = faces.grid
     sizes = level_sizes(grid, faces.levels)
     count = 6 if anisotropic else 1
-    vols = into or ConeVolumes([texture3d(ctx, grid.size, len(sizes)) for _ in range(count)], grid, len(sizes),
-                               anisotropic)
+    vols = into or ConeVolumes([texture3d(ctx, grid.size, len(sizes), zero=True) for _ in range(count)], grid,
+                               len(sizes), anisotropic)  # level 0 zeroed: MODE_BASE stores covered faces only
     variant = {"MODE_ANISO": None} if anisotropic else {}
     prog = programs.compute("vct/mipmap.glsl", {"MODE_BASE": None, **variant})
     bind_samplers(prog, "u_src", faces.textures, 0)

@@ -153,9 +153,12 @@ void main() {
     vec4 face[6];
     for (int g = 0; g < 6; ++g) face[g] = src_face(g, v, 0);
 #if defined(MODE_ANISO)
+    // A face without coverage would store zeros, which level 0 holds already: build_volumes zeroes it, and the
+    // coverage is the geometry's, the same in every build into the same volumes (llvmpipe's image stores are slow,
+    // and most voxels are empty).
     for (int f = 0; f < 6; ++f) {
         vec4 s = face[f ^ 1];
-        store_dst(f, v, stored(s.rgb, s.a));
+        if (s.a > 0.0) store_dst(f, v, stored(s.rgb, s.a));
     }
 #else
     float alpha = 0.0, weight = 0.0;
@@ -166,7 +169,7 @@ void main() {
         weight += plus.a;
         alpha = max(alpha, plus.a);
     }
-    imageStore(u_dst[0], v, stored(weight > 0.0 ? radiance / weight : vec3(0.0), alpha));
+    if (alpha > 0.0) imageStore(u_dst[0], v, stored(weight > 0.0 ? radiance / weight : vec3(0.0), alpha));
 #endif
 }
 #endif
