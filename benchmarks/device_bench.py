@@ -29,7 +29,8 @@ SCENES = ("cornell", "spot_room", "courtyard")
 RESOLUTIONS = ((320, 240), (640, 480))
 ERROR_RES = (320, 240)  # references are exported at this size only (they travel: 3 passes × 3 scenes ≈ 8 MB)
 REF_PASSES = ("Diffuse Indirect", "Combined", "Depth")
-VCT_PASSES = ("vct_voxelize", "vct_inject", "vct_mipmap", "vct_bounce", "vct_specular", "vct_trace", "vct_upsample")
+VCT_PASSES = ("vct_voxelize", "vct_albedo", "vct_inject", "vct_mipmap", "vct_bounce", "vct_specular", "vct_trace",
+              "vct_upsample")
 LPV_PASSES = ("rsm", "lpv_inject", "geometry_volume", "lpv_propagate", "lpv_lighting")
 OCTREE_CONFIGS = (("uniform k=16", dict(max_iterations=16, epsilon=0.0)), ("octree L=3 k=4", dict(octree_levels=3,
                                                                                                   octree_iterations=4)))
@@ -89,6 +90,7 @@ def _errors(result, ref):
 def run(engine, scene_dir, grids, lpv_grids, repeats, say):
     from bounce_gi.gpu_kernels.lpv.settings import LpvSettings
     from bounce_gi.gpu_kernels.settings import RenderSettings
+    from bounce_gi.gpu_kernels.vct.passes import pass_seconds
     from bounce_gi.gpu_kernels.vct.settings import VctSettings
 
     say(f"\nVCT (defaults: {VctSettings().bounces} bounces, {VctSettings().gathered_bounces} gathered)")
@@ -100,7 +102,7 @@ def run(engine, scene_dir, grids, lpv_grids, repeats, say):
             for grid in grids:
                 settings = RenderSettings("vct", w, h, vct=VctSettings(resolution=grid))
                 total, runs = _timed(engine, scene, settings, repeats)
-                times = [statistics.median(r[1].timings.get(p, 0.0) for r in runs) * 1000 for p in VCT_PASSES]
+                times = [statistics.median(pass_seconds(r[1].timings, p) for r in runs) * 1000 for p in VCT_PASSES]
                 say(f"{name:<11}{grid:>5}³{f'{w}x{h}':>9}" + "".join(f"{t:>10.1f}" for t in times) +
                     f"{total * 1000:>9.1f}" + _errors(runs[-1][1], ref))
     say("\nLPV (3 bounces, adaptive iterations)")

@@ -17,7 +17,8 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
-PASSES = ("vct_voxelize", "vct_inject", "vct_mipmap", "vct_bounce", "vct_specular", "vct_trace", "vct_upsample")
+PASSES = ("vct_voxelize", "vct_albedo", "vct_inject", "vct_mipmap", "vct_bounce", "vct_specular", "vct_trace",
+          "vct_upsample")
 EXTRA_SCENES = ("glossy_cornell",)
 
 
@@ -88,6 +89,7 @@ def scene_rows(args, engine, name, res):
     from bounce_gi.addon.extract import extract_scene
     from bounce_gi.addon.reference.cycles import ReferenceSettings, render_reference
     from bounce_gi.gpu_kernels.settings import RenderSettings
+    from bounce_gi.gpu_kernels.vct.passes import pass_seconds
     from bounce_gi.gpu_kernels.vct.settings import VctSettings
 
     w, h = (int(v) for v in res.lower().split("x"))
@@ -104,7 +106,7 @@ def scene_rows(args, engine, name, res):
             runs = timed_runs(engine, scene, RenderSettings("vct", w, h, vct=vs), args.repeats)
             total = statistics.median(r[0] for r in runs)
             result = runs[-1][1]
-            times = [statistics.median(r[1].timings.get(p, 0.0) for r in runs) * 1000 for p in PASSES]
+            times = [statistics.median(pass_seconds(r[1].timings, p) for r in runs) * 1000 for p in PASSES]
             print(f"{name:<15}{grid:>5}³{res:>9}{scale:>3}" + "".join(f"{t:>10.0f}" for t in times) +
                   f"{total * 1000:>9.0f}{result.info.get('fixup_pixels', 0):>6}" + error_columns(result, ref),
                   flush=True)

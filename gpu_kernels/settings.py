@@ -70,9 +70,9 @@ def method_bytes(scene: Scene, settings: RenderSettings) -> int:
     """About how many bytes of GPU memory the method's volumes take (0 for "none")."""
     if settings.method == "vct":
         from .vct.inject import front_bytes
-        from .vct.memory import traced_texels
         from .vct.parts import parts_bytes, scene_parts
         from .vct.replay import pool_bytes
+        from .vct.settings import traced_texels
         from .vct.volumes import vct_grid
         from .voxel.voxelize import scene_area
 

@@ -219,8 +219,8 @@ def vct_memory(scene) -> list:
     scene's resolution."""
     from dataclasses import replace
 
-    from ...gpu_kernels.vct.memory import cached_bytes, traced_texels
-    from ...gpu_kernels.vct.settings import VctSettings
+    from ...gpu_kernels.vct.memory import cached_bytes
+    from ...gpu_kernels.vct.settings import VctSettings, traced_texels
     from ...gpu_kernels.voxel.voxelize import scene_area
 
     s, area = VctSettings(), scene_area(scene)

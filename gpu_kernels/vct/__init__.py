@@ -8,9 +8,9 @@ Passes (vct/passes.py runs them through the pass cache):
                 vct/face_albedo.glsl): a material's colour edit re-makes this, not the voxels or the light;
   vct_inject    surface points rasterised along their dominant axis and lit by every light exactly as the Diffuse
                 Direct pass lights pixels (direct/eval.glsl), averaged into six faces per voxel: the light arriving
-                through each face, its coverage and where its surfaces lie (vct/inject*.glsl); the lamps, the
-                emissive meshes and the sky each in a pass of its own, summed and multiplied by the faces' albedo,
-                so an edit re-injects only its part (vct/parts.py);
+                at the surfaces whose light leaves through each face, its coverage and where those surfaces lie
+                (vct/inject*.glsl); the lamps, the emissive meshes and the sky each in a pass of its own, summed and
+                multiplied by the faces' albedo, so an edit re-injects only its part (vct/parts.py);
   vct_mipmap    the filtered radiance volumes: isotropic (mean of children) or anisotropic (six directions,
                 composited front to back, plus where each texel's surfaces lie along each axis, so a cone skips
                 surfaces behind where it started) (vct/mipmap.glsl, Freed 2018, §4.4);

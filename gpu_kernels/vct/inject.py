@@ -21,6 +21,9 @@ from .volumes import FaceAlbedo, Faces, VoxelGeometry
 
 
 INJECT_SAMPLES = 2  # raster samples per voxel edge: ~4 surface points per voxel face; slivers fall back (vct_inject)
+# Sums a voxel face's accumulator holds (the shaders' ACC_CHANNELS): the light's Σw·E/π, Σw, Σw·p; the albedo's
+# Σw·albedo, Σw.
+LIGHT_SUMS, ALBEDO_SUMS = 8, 4
 COVER_TEST_BYTES = 256 * 2 ** 20  # the front-most images' budget (32 MiB at 64³); larger grids skip the cover test
 
 
@@ -40,12 +43,8 @@ def inject(ctx, programs, scene: Scene, geometry, textures: list, vox, shadows, 
     own = scratch is None
     scratch = {} if own else scratch
     try:
-        acc = _accumulator(ctx, grid, scratch)
-        side = max(grid.size) * INJECT_SAMPLES
-        if "fronts" not in scratch:  # the front-most surfaces first (MODE_FRONT): the geometry's, whatever the lights
-            scratch["fronts"] = front_images(ctx, grid, side)
-            if scratch["fronts"]:
-                _raster_pass(ctx, programs, {"MODE_FRONT": None}, (scene, geometry, textures), shadows, grid, scratch)
+        acc = _accumulator(ctx, grid, scratch, LIGHT_SUMS)
+        front_surfaces(ctx, programs, (scene, geometry, textures), grid, scratch)
         _raster_pass(ctx, programs, {}, (scene, geometry, textures), shadows, grid, scratch)
         for outputs, defines in ((faces.textures, {}),) + (() if kept else ((faces.centroids,
                                                                               {"WRITE_CENTROIDS": None}),)):
@@ -64,9 +63,9 @@ def inject(ctx, programs, scene: Scene, geometry, textures: list, vox, shadows, 
     return faces
 
 
-def _accumulator(ctx, grid, scratch: dict, channels: int = 8):
-    """The raster's sums (vct/inject_raster.glsl: `channels` a face, its ACC_CHANNELS), zeroed: `scratch`'s, or
-    made and left there."""
+def _accumulator(ctx, grid, scratch: dict, channels: int):
+    """The raster's sums (vct/inject_raster.glsl: `channels` a face, LIGHT_SUMS or ALBEDO_SUMS), zeroed:
+    `scratch`'s, or made and left there."""
     import moderngl
 
     if "acc" not in scratch:
@@ -84,39 +83,54 @@ def release_scratch(scratch: dict) -> None:
             t.release()
 
 
+def front_surfaces(ctx, programs, drawn: tuple, grid, scratch: dict) -> list:
+    """The front-most surfaces of `drawn` = (scene, geometry, textures) per raster column, voxel layer and side
+    (front_images, filled by vct/inject_raster.glsl MODE_FRONT): `scratch`'s, or made and left there. They depend
+    on the geometry alone, so the albedo pass and every injection of a frame share them."""
+    if "fronts" not in scratch:
+        scratch["fronts"] = front_images(ctx, grid, max(grid.size) * INJECT_SAMPLES)
+        if scratch["fronts"]:
+            _raster_pass(ctx, programs, {"MODE_FRONT": None, "MODE_ALBEDO": None}, drawn, None, grid, scratch)
+    return scratch["fronts"]
+
+
 def _raster_pass(ctx, programs, defines: dict, drawn: tuple, shadows, grid, scratch: dict) -> None:
     """vct/inject_raster.glsl in mode `defines` over every triangle of `drawn` = (scene, geometry, textures), into
-    the scratch's accumulator and front-most images; lit by `shadows`' lights (None: MODE_ALBEDO, no light)."""
+    the scratch's accumulator (where it has one) and front-most images; lit by `shadows`' lights (None: no light,
+    MODE_ALBEDO)."""
     side = max(grid.size) * INJECT_SAMPLES
     fronts = scratch["fronts"]
-    prog = programs.raster("vct/inject_raster.glsl", {**defines, **(shadows.defines if shadows else {})})
+    sums = ALBEDO_SUMS if "MODE_ALBEDO" in defines else LIGHT_SUMS
+    prog = programs.raster("vct/inject_raster.glsl", {**defines, **(shadows.defines if shadows else {}),
+                                                      "ACC_CHANNELS": sums})
     bind_grid(prog, grid, 1)
     if shadows is not None:
         bind_lights(prog, shadows, unit=2, sky_stride=SKY_INJECTION_STRIDE)
     set_uniforms(prog, {"u_samples": float(INJECT_SAMPLES), "u_viewport": (float(side), float(side)),
                         "u_cover_test": bool(fronts)})
-    scratch["acc"].bind_to_image(0, read=True, write=True)
+    if "acc" in scratch:
+        scratch["acc"].bind_to_image(0, read=True, write=True)
     for i, t in enumerate(fronts):
         t.bind_to_image(1 + i, read=True, write=True)
     _rasterise(ctx, prog, *drawn, side)
     ctx.memory_barrier()
 
 
-def face_albedo(ctx, programs, scene: Scene, geometry, textures: list, vox) -> FaceAlbedo:
+def face_albedo(ctx, programs, scene: Scene, geometry, textures: list, vox, scratch: dict | None = None) -> FaceAlbedo:
     """Each voxel face's albedo: the mean over the surface points whose light the injection sends through it,
     with the same weights and covered sides left out (vct/inject_raster.glsl MODE_ALBEDO, vct/face_albedo.glsl).
-    Made from the geometry and the materials alone: a light edit keeps it, a colour edit re-makes it alone."""
+    Made from the geometry and the materials alone: a light edit keeps it, a colour edit re-makes it alone. The
+    front-most surfaces are `scratch`'s (front_surfaces; none: made and released here)."""
     grid = vox.grid
     out = FaceAlbedo([texture3d(ctx, grid.size, zero=True, dtype="f2") for _ in range(6)], grid)
-    scratch = {}
+    own = scratch is None
+    scratch = {} if own else scratch
+    drawn = (scene, geometry, textures)
+    sums = {"fronts": front_surfaces(ctx, programs, drawn, grid, scratch)}  # its own accumulator, the shared fronts
     try:
-        acc = _accumulator(ctx, grid, scratch, channels=4)
-        scratch["fronts"] = front_images(ctx, grid, max(grid.size) * INJECT_SAMPLES)
-        drawn = (scene, geometry, textures)
-        if scratch["fronts"]:
-            _raster_pass(ctx, programs, {"MODE_FRONT": None, "MODE_ALBEDO": None}, drawn, None, grid, scratch)
-        _raster_pass(ctx, programs, {"MODE_ALBEDO": None}, drawn, None, grid, scratch)
-        prog = programs.compute("vct/face_albedo.glsl")
+        acc = _accumulator(ctx, grid, sums, ALBEDO_SUMS)
+        _raster_pass(ctx, programs, {"MODE_ALBEDO": None}, drawn, None, grid, sums)
+        prog = programs.compute("vct/face_albedo.glsl", {"ACC_CHANNELS": ALBEDO_SUMS})
         unit = bind_samplers(prog, "u_area", [vox.area], 0)
         bind_samplers(prog, "u_acc", [acc], unit)
         set_uniform(prog, "u_grid_size", tuple(int(n) for n in grid.size))
@@ -125,13 +139,16 @@ def face_albedo(ctx, programs, scene: Scene, geometry, textures: list, vox) -> F
         dispatch(prog, grid.size)
         ctx.memory_barrier()
     finally:
-        release_scratch(scratch)
+        if "acc" in sums:
+            sums["acc"].release()
+        if own:
+            release_scratch(scratch)
     return out
 
 
 def _resolve_program(programs, defines: dict, vox, acc, shadows, grid, outputs):
     """vct/inject.glsl in mode `defines`, its volumes, lights, grid and output images bound."""
-    prog = programs.compute("vct/inject.glsl", {**defines, **shadows.defines})
+    prog = programs.compute("vct/inject.glsl", {**defines, **shadows.defines, "ACC_CHANNELS": LIGHT_SUMS})
     unit = bind_samplers(prog, "u_area", [vox.area], 0)
     unit = bind_samplers(prog, "u_normal", [vox.normal], unit)
     unit = bind_samplers(prog, "u_acc", [acc], unit)

@@ -8,18 +8,12 @@ from __future__ import annotations
 import math
 
 from ..scene import Scene
-from .parts import parts_bytes, scene_parts
+from .parts import FACE_BYTES, parts_bytes, scene_parts
 from .replay import hits_bytes, steps_bytes
 from .settings import VctSettings
-from .volumes import level_sizes, mip_levels, vct_grid
+from .volumes import FACE_ALBEDO_BYTES, level_sizes, mip_levels, vct_grid
 
-RGBA32F, RGBA16F = 16, 8  # bytes a texel
-
-
-def traced_texels(width: int, height: int, settings: VctSettings) -> tuple:
-    """(w, h) texels the per-pixel trace runs at for a width × height image (indirect_scale)."""
-    scale = settings.indirect_scale
-    return -(-int(width) // scale), -(-int(height) // scale)
+RGBA32F = 16  # bytes a texel of the voxels' and the layer volume's textures
 
 
 def cached_bytes(scene: Scene, settings: VctSettings, traced: tuple, area: float) -> dict:
@@ -30,9 +24,9 @@ def cached_bytes(scene: Scene, settings: VctSettings, traced: tuple, area: float
     mip_voxels = sum(math.prod(size) for size in level_sizes(grid, mip_levels(settings.resolution)))
     return {
         "voxels: areas, normals (vct_voxelize)": 2 * RGBA32F * voxels,
-        "faces' albedo (vct_albedo)": 6 * RGBA16F * voxels,
+        "faces' albedo (vct_albedo)": FACE_ALBEDO_BYTES * voxels,
         "lights' parts, light per unit albedo (vct_inject_*)": parts_bytes(grid, scene_parts(scene)),
-        "faces' centroids (vct_geometry)": 6 * RGBA32F * voxels,
+        "faces' centroids (vct_geometry)": FACE_BYTES * voxels,
         "layer volume, every level (vct_geometry)": RGBA32F * mip_voxels,
         "bounce gathers' steps (vct_geometry)": steps_bytes(area, grid.cell),
         "per-pixel sub-rays' hits (vct_hits)": hits_bytes(traced),

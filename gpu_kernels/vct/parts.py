@@ -10,11 +10,13 @@ a part is one light whose colour or power alone changed (the sky's colour or str
 records per unit of its colour are unchanged and nothing is injected: the parts are summed with the new weights.
 The bounces that follow run as after any light edit (vct/replay.py replays them).
 
-A cold render injects and sums the same parts, so it gives what an edit gives. A scene with one part injects it as
-before (its records per unit of its colour are the transport's) and takes its faces as they are, without a copy.
-Each part keeps six face volumes (PART_BYTES_CAP bounds the parts of a scene with more than one): more than fit fall
-back to one injection of every light. A part's key holds its lights' shadow views as packed in the atlas, so a
-light added or removed elsewhere, which moves the maps in the atlas, injects every part again.
+The parts hold the light arriving at each face per unit albedo (vct/inject.py); their sum is multiplied by the
+faces' albedo (vct/inject.face_albedo), so a material's colour edit re-makes the albedo and the sum, not the parts.
+A cold render injects and sums the same parts, so it gives what an edit gives; a scene with one part sums it alone
+(a copy: six more face volumes). Each part keeps six face volumes (PART_BYTES_CAP bounds the parts of a scene with
+more than one): more than fit fall back to one part of every light (ALL). A part's key holds its lights' shadow
+views as packed in the atlas, so a light added or removed elsewhere, which moves the maps in the atlas, injects
+every part again.
 """
 from __future__ import annotations
 
@@ -31,6 +33,7 @@ from .inject import face_flux
 from .volumes import FaceAlbedo, Faces
 
 PARTS = ("lamps", "emitters", "sky")  # the pass of each is vct_inject_<name>
+ALL = "all"  # vct_inject_all: every light in one part, where the parts' face volumes would not fit
 PART_BYTES_CAP = 128 * 2 ** 20  # the parts' face volumes together (a part at 64³: 24 MiB)
 FACE_BYTES = 6 * 16  # six RGBA32F face volumes a voxel
 
@@ -59,6 +62,16 @@ def light_parts(shadows) -> list[Part]:
     return out
 
 
+def injected_parts(shadows, grid) -> list[Part]:
+    """The parts the lights are injected in: light_parts, or, where their face volumes would not fit `grid` (or
+    there is no light), one part ALL of every light."""
+    found = light_parts(shadows)
+    if found and fits(grid, len(found)):
+        return found
+    records = shadows.buffers.lights
+    return [Part(ALL, np.arange(len(records)), largest_colour(records["color_type"][:, :3]))]
+
+
 def scene_parts(scene: Scene) -> int:
     """How many parts `scene`'s lights make (settings.method_bytes: before any light record exists)."""
     lamps = any(light.power > 0 for light in scene.lights)
@@ -68,8 +81,8 @@ def scene_parts(scene: Scene) -> int:
 
 
 def fits(grid, parts: int) -> bool:
-    """Whether `parts` parts are injected apart on `grid`: one always (it is the injection), more where their
-    face volumes fit PART_BYTES_CAP."""
+    """Whether `parts` parts are injected apart on `grid`: one always (it is every light), more where their face
+    volumes fit PART_BYTES_CAP."""
     return parts <= 1 or parts * grid.voxel_count * FACE_BYTES <= PART_BYTES_CAP
 
 

@@ -8,10 +8,10 @@
                       (volumes.VoxelGeometry)
     vct_inject_lamps, _emitters, _sky
                     ← voxels, that part's lights' shadow maps and records per unit of its largest colour: the light
-                      arriving at each face per unit albedo (vct/parts.py); every light at once in vct_inject
-                      instead where several parts' volumes would not fit
-    vct_inject      ← the parts and their weights, summed and multiplied by the faces' albedo; or voxels, shadow
-                      maps, the lights per unit of the largest colour (vct/colours.py) and the albedo
+                      arriving at each face per unit albedo (vct/parts.py); vct_inject_all instead, every light at
+                      once (per unit of the largest colour, vct/colours.py), where several parts' volumes would not
+                      fit
+    vct_inject      ← the parts and their weights, summed and multiplied by the faces' albedo
     vct_mipmap      ← injection, anisotropy
     vct_bounce      ← mipmaps, cone settings, bounces
     vct_specular    ← gbuffer, bounced volumes, specular settings
@@ -47,15 +47,19 @@ def run(frame) -> MethodOutput:
     k_vox = (frame.keys["geometry"], grid.key())
     vox = cache.run("vct_voxelize", k_vox,
                     lambda: voxelize_scene(ctx, programs, scene, frame.geometry, frame.textures, grid))
-    k_albedo = (k_vox, frame.keys["materials"])
-    albedo = cache.run("vct_albedo", k_albedo, lambda: inject.face_albedo(ctx, programs, scene, frame.geometry,
-                                                                          frame.textures, vox))
+    shared = cache.run("vct_geometry", (frame.keys["geometry"], frame.keys["emission"], grid.key(), levels),
+                       VoxelGeometry)
     # The lights per unit of the largest colour (vct/colours.py): an edit scaling every light alike keeps all that
     # follows, and only the results are scaled back.
     scale = colours.colour_scale(frame.shadows)
-    shared = cache.run("vct_geometry", (frame.keys["geometry"], frame.keys["emission"], grid.key(), levels),
-                       VoxelGeometry)
-    faces, k_inject = _inject(frame, vox, shared, (k_vox, levels, albedo, k_albedo), scale)
+    scratch = {}  # the front-most surfaces (and the light's accumulator) shared by this frame's albedo and injections
+    try:
+        k_albedo = (k_vox, frame.keys["materials"])
+        albedo = cache.run("vct_albedo", k_albedo, lambda: inject.face_albedo(
+            ctx, programs, scene, frame.geometry, frame.textures, vox, scratch))
+        faces, k_inject = _inject(frame, vox, shared, (k_vox, levels, albedo, k_albedo), scale, scratch)
+    finally:
+        inject.release_scratch(scratch)
     k_mip = (k_inject, s.anisotropic)
     volumes = cache.run("vct_mipmap", k_mip, lambda: mipmap.build_volumes(ctx, programs, faces, s.anisotropic,
                                                                          shared=shared))
@@ -77,50 +81,38 @@ def run(frame) -> MethodOutput:
     return MethodOutput(*out, key, colours.scale_info(info, scale), has_ao=True)
 
 
-def _inject(frame, vox, shared, base: tuple, scale: np.ndarray) -> tuple:
-    """vct_inject: each part of the lights (the lamps, the emissive meshes, the sky) injected in its own pass per unit
-    of its colour and albedo, summed with weights and multiplied by the faces' albedo (vct/parts.py), or, where the
-    parts' volumes would not fit, every light at once per unit of `scale`, multiplied alike. `base` = (the voxels'
-    key, levels, the faces' albedo, its key). Returns the faces and their key."""
+def pass_seconds(timings: dict, name: str) -> float:
+    """A render's seconds in pass `name` (RenderResult.timings), vct_inject with the parts it sums
+    (vct_inject_lamps, _emitters, _sky, _all): the benchmarks' per-pass tables."""
+    names = [name] + ([f"{name}_{p}" for p in parts.PARTS + (parts.ALL,)] if name == "vct_inject" else [])
+    return sum(timings.get(n, 0.0) for n in names)
+
+
+def _inject(frame, vox, shared, base: tuple, scale: np.ndarray, scratch: dict) -> tuple:
+    """vct_inject: each part of the lights (the lamps, the emissive meshes, the sky; or every light at once where
+    their volumes would not fit, vct_inject_all) injected in its own pass per unit of its colour and albedo, summed
+    with weights back to the transport's unit `scale` and multiplied by the faces' albedo (vct/parts.py). `base` =
+    (the voxels' key, levels, the faces' albedo, its key); `scratch` as vct/inject.inject's. Returns the faces and
+    their key."""
     ctx, programs, cache, shadows = frame.ctx, frame.programs, frame.cache, frame.shadows
     k_vox, levels, albedo, k_albedo = base
-    scratch = {}  # the accumulator and front-most surfaces, shared by the parts injected in this frame
 
     def injected(subset):
         return colours.with_records(ctx, shadows, subset, lambda sh: inject.inject(
             ctx, programs, frame.scene, frame.geometry, frame.textures, vox, sh, levels, shared, scratch))
 
-    def reflected(made, weights):
-        return parts.sum_parts(ctx, programs, made, weights, albedo, shared.centroids)
-
-    light_parts = parts.light_parts(shadows)
-    try:
-        if not light_parts or not parts.fits(vox.grid, len(light_parts)):
-            cache.drop([f"vct_inject_{name}" for name in parts.PARTS])
-            records = colours.unit_records(shadows, scale)
-            k_inject = (k_vox, colours.unit_key(shadows, records), levels, k_albedo)
-            return cache.run("vct_inject", k_inject, lambda: _released_after(
-                injected(records), lambda light: reflected([light], [np.ones(3, np.float32)]))), k_inject
-        made, keys = [], []
-        for part in light_parts:
-            subset = colours.unit_records(shadows, part.scale, part.lights)
-            key = (k_vox, parts.part_key(shadows, part, subset), levels)
-            made.append(cache.run(f"vct_inject_{part.name}", key, lambda subset=subset: injected(subset)))
-            keys.append(key)
-    finally:
-        inject.release_scratch(scratch)
-    cache.drop([f"vct_inject_{name}" for name in set(parts.PARTS) - {p.name for p in light_parts}])
-    weights = [part.scale / scale for part in light_parts]
+    injected_parts = parts.injected_parts(shadows, vox.grid)
+    made, keys = [], []
+    for part in injected_parts:
+        subset = colours.unit_records(shadows, part.scale, part.lights)
+        key = (k_vox, parts.part_key(shadows, part, subset), levels)
+        made.append(cache.run(f"vct_inject_{part.name}", key, lambda subset=subset: injected(subset)))
+        keys.append(key)
+    cache.drop([f"vct_inject_{name}" for name in set(parts.PARTS + (parts.ALL,)) - {p.name for p in injected_parts}])
+    weights = [part.scale / scale for part in injected_parts]
     k_inject = (tuple(keys), np.asarray(weights, np.float32).tobytes(), k_albedo)
-    return cache.run("vct_inject", k_inject, lambda: reflected(made, weights)), k_inject
-
-
-def _released_after(faces, use):
-    """use(faces), then faces released."""
-    try:
-        return use(faces)
-    finally:
-        faces.release()
+    return cache.run("vct_inject", k_inject, lambda: parts.sum_parts(ctx, programs, made, weights, albedo,
+                                                                       shared.centroids)), k_inject
 
 
 def _per_pixel(frame, faces, bounced, base, grid):

@@ -130,3 +130,10 @@ class VctSettings:
         if kind == "bounce" and self.bounce_cones:  # the gathers at voxel faces use bounce_cones, not diffuse_cones
             extra = tuple(name for name in extra if name != "diffuse_cones")
         return tuple((name, d[name]) for name in extra)
+
+
+def traced_texels(width: int, height: int, settings: VctSettings) -> tuple:
+    """(w, h) texels the per-pixel trace runs at for a width × height image: ceil(W/s) × ceil(H/s) for
+    s = indirect_scale."""
+    scale = int(settings.indirect_scale)
+    return -(-int(width) // scale), -(-int(height) // scale)

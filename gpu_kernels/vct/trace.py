@@ -12,7 +12,7 @@ from ..common.grid import Grid
 from ..gl.bind import bind_grid, bind_samplers, dispatch, read_texture, set_uniform, set_uniforms, write_uniform
 from . import replay
 from .cones import MAX_CONES, cone_table, subray_radius
-from .settings import VctSettings
+from .settings import VctSettings, traced_texels
 from .volumes import ConeVolumes, Faces, bind_volumes
 
 
@@ -32,9 +32,8 @@ def bind_cones(prog, grid: Grid, levels: int, s: VctSettings) -> None:
 
 
 def traced_size(gbuffer, s: VctSettings) -> tuple:
-    """The texels vct_trace gathers at: ceil(W/s) × ceil(H/s) for s = indirect_scale."""
-    scale = int(s.indirect_scale)
-    return tuple(-(-int(n) // scale) for n in gbuffer.size)
+    """The texels vct_trace gathers at for this G-buffer (settings.traced_texels)."""
+    return traced_texels(*gbuffer.size, s)
 
 
 def trace(ctx, programs, gbuffer, faces: Faces, volumes: ConeVolumes, s: VctSettings,

@@ -51,10 +51,14 @@ def level_sizes(grid: Grid, levels: int) -> list[tuple]:
     return [tuple(int(n) >> level for n in grid.size) for level in range(levels)]
 
 
+FACE_ALBEDO_BYTES = 6 * 8  # FaceAlbedo: six RGBA16F texels a voxel
+
+
 @dataclass
 class FaceAlbedo:
     """Six RGBA16F 3D textures, one per voxel face (as Faces): rgb = the albedo of the surfaces whose light leaves
-    through that face (vct/inject.face_albedo), 0 where there are none."""
+    through that face (vct/inject.face_albedo; where none does, its neighbours' or its voxel's other faces'), 0 in
+    empty voxels."""
     textures: list
     grid: Grid
 

@@ -13,16 +13,13 @@ from bounce_gi.gpu_kernels.scene import Light, Material
 from bounce_gi.gpu_kernels.settings import RenderSettings
 from bounce_gi.gpu_kernels.vct.settings import VctSettings
 from bounce_gi.gpu_kernels.vct.trace import read_level
-from support.synthetic import box_quads, quad, quad_scene
+from support.lpv_transfer import rerun
+from support.synthetic import open_room_with_block, quad, quad_scene
 
 SETTINGS = RenderSettings("vct", 40, 30, vct=VctSettings(resolution=32))
 FLOAT16 = 1e-3
 WHITE, RUG, WALL = (0.8, 0.8, 0.8), (0.7, 0.1, 0.05), (0.1, 0.6, 0.2)
 PX, MX, PY, MY, PZ, MZ = range(6)  # face directions +x, −x, +y, −y, +z, −z
-
-
-def _rerun(result) -> set:
-    return {k for k in result.timings if k not in result.skipped and k != "total"}
 
 
 def _albedo(engine) -> tuple:
@@ -72,17 +69,6 @@ def test_each_face_reflects_its_own_surface():
             assert np.allclose(faces[PZ][v][:3], WHITE, atol=FLOAT16), (v, faces[PZ][v])
 
 
-def _room(block=(0.2, 0.5, 0.8)):
-    """An open-topped room lit by a lamp and the sky (two parts, vct/parts.py), with a coloured block."""
-    matrix = np.eye(4)
-    matrix[:3, 3] = (-0.5, 0.2, 1.5)
-    quads = box_quads((-1, -1, 0), (1, 1, 2), 0, skip=((2, "hi"),))
-    quads += box_quads((-0.3, -0.3, 0.0), (0.3, 0.3, 0.7), 1, inward=False)
-    return quad_scene(quads, [Material("walls", (0.7, 0.6, 0.5)), Material("block", block)],
-                      [Light("lamp", "POINT", (1.0, 0.9, 0.8), 60.0, matrix)], (0.0, -0.9, 1.5), (0.0, 0.5, 0.3),
-                      world=(0.05, 0.07, 0.1))
-
-
 def test_a_colour_edit_keeps_the_voxels_and_the_light():
     """The block recoloured: only the faces' albedo, the sum of the parts and what follows them run again — not the
     voxelisation, the geometry's parts or any part's injection — and the image is what a render from scratch of the
@@ -90,17 +76,17 @@ def test_a_colour_edit_keeps_the_voxels_and_the_light():
     what may differ is the order of the injection's compare-and-swap adds (measured 0 on llvmpipe)."""
     engine, fresh = Engine(), Engine()
     try:
-        engine.render(_room(), SETTINGS)
-        edited = engine.render(_room(block=(0.9, 0.3, 0.1)), SETTINGS)
-        rerun = _rerun(edited)
-        assert {"vct_albedo", "vct_inject", "vct_bounce"} <= rerun, rerun
-        assert not rerun & {"vct_voxelize", "vct_geometry", "vct_inject_lamps", "vct_inject_sky"}, rerun
-        cold = fresh.render(_room(block=(0.9, 0.3, 0.1)), SETTINGS)
+        engine.render(open_room_with_block(), SETTINGS)
+        edited = engine.render(open_room_with_block(block=(0.9, 0.3, 0.1)), SETTINGS)
+        ran = set(rerun(edited))
+        assert {"vct_albedo", "vct_inject", "vct_bounce"} <= ran, ran
+        assert not ran & {"vct_voxelize", "vct_geometry", "vct_inject_lamps", "vct_inject_sky"}, ran
+        cold = fresh.render(open_room_with_block(block=(0.9, 0.3, 0.1)), SETTINGS)
         for name in ("Diffuse Indirect", "Combined"):
             a, b = edited.passes[name], cold.passes[name]
             assert np.abs(a - b).max() <= 1e-6 * float(np.abs(b).max()), name
-        before = engine.render(_room(), SETTINGS)  # and back: the first colours' albedo again, the light kept
-        assert not _rerun(before) & {"vct_voxelize", "vct_inject_lamps", "vct_inject_sky"}
+        before = engine.render(open_room_with_block(), SETTINGS)  # and back: the light kept
+        assert not set(rerun(before)) & {"vct_voxelize", "vct_inject_lamps", "vct_inject_sky"}
     finally:
         engine.shutdown()
         fresh.shutdown()

@@ -163,7 +163,7 @@ def test_parts_bytes():
 
     grid = Grid((0.0, 0.0, 0.0), 0.1, (64, 64, 64))
     assert parts.parts_bytes(grid, 1) == 64 ** 3 * 96 and parts.fits(grid, 1) and parts.fits(grid, 3)
-    assert parts.fits(Grid((0.0, 0.0, 0.0), 0.1, (512, 512, 512)), 1)  # one part is the injection itself
+    assert parts.fits(Grid((0.0, 0.0, 0.0), 0.1, (512, 512, 512)), 1)  # one part is every light
     assert parts.parts_bytes(grid, 3) == 3 * 64 ** 3 * 96 <= parts.PART_BYTES_CAP
     assert parts.parts_bytes(Grid((0.0, 0.0, 0.0), 0.1, (128, 128, 128)), 2) == 128 ** 3 * 96  # all lights at once
     assert parts.scene_parts(_room()) == 3

@@ -9,24 +9,13 @@ from bounce_gi.gpu_kernels.engine import Engine
 from bounce_gi.gpu_kernels.scene import Light, Material
 from bounce_gi.gpu_kernels.settings import RenderSettings
 from bounce_gi.gpu_kernels.vct import parts
-from bounce_gi.gpu_kernels.vct.memory import cached_bytes, traced_texels
-from bounce_gi.gpu_kernels.vct.settings import VctSettings
+from bounce_gi.gpu_kernels.vct.memory import cached_bytes
+from bounce_gi.gpu_kernels.vct.settings import VctSettings, traced_texels
 from bounce_gi.gpu_kernels.voxel.voxelize import scene_area
-from support.synthetic import box_quads, quad_scene
+from support.synthetic import open_room_with_block
 
 SETTINGS = RenderSettings("vct", 40, 30, vct=VctSettings(resolution=32))
 DTYPE_BYTES = {"f4": 4, "f2": 2, "u4": 4}
-
-
-def _room():
-    """An open-topped room with a block, lit by a lamp and the sky: two parts."""
-    matrix = np.eye(4)
-    matrix[:3, 3] = (-0.5, 0.2, 1.5)
-    quads = box_quads((-1, -1, 0), (1, 1, 2), 0, skip=((2, "hi"),))
-    quads += box_quads((-0.3, -0.3, 0.0), (0.3, 0.3, 0.7), 1, inward=False)
-    return quad_scene(quads, [Material("walls", (0.7, 0.6, 0.5)), Material("block", (0.2, 0.5, 0.8))],
-                      [Light("lamp", "POINT", (1.0, 0.9, 0.8), 60.0, matrix)], (0.0, -0.9, 1.5), (0.0, 0.5, 0.3),
-                      world=(0.05, 0.07, 0.1))
 
 
 def _level0(textures) -> int:
@@ -38,7 +27,7 @@ def _pool_bytes(pool) -> int:
 
 
 def test_the_estimate_is_what_a_render_keeps():
-    scene = _room()
+    scene = open_room_with_block()
     engine = Engine()
     try:
         engine.render(scene, SETTINGS)

@@ -170,3 +170,14 @@ def room_with_box(z, size=0.3, height=None, turn=0.0):
     return quad_scene(quads, [Material("floor", (0.7, 0.7, 0.7)), Material("box", (0.8, 0.3, 0.2))],
                       [Light("bulb", "POINT", (1, 1, 1), 60.0, bulb)], (0.0, -0.95, 1.0), (0.0, 0.5, 0.6),
                       lens=12.0)
+
+
+def open_room_with_block(block=(0.2, 0.5, 0.8)):
+    """An open-topped 2 × 2 × 2 m room with a coloured block, lit by a lamp and a dim sky (two VCT parts)."""
+    matrix = np.eye(4)
+    matrix[:3, 3] = (-0.5, 0.2, 1.5)
+    quads = box_quads((-1, -1, 0), (1, 1, 2), 0, skip=((2, "hi"),))
+    quads += box_quads((-0.3, -0.3, 0.0), (0.3, 0.3, 0.7), 1, inward=False)
+    return quad_scene(quads, [Material("walls", (0.7, 0.6, 0.5)), Material("block", block)],
+                      [Light("lamp", "POINT", (1.0, 0.9, 0.8), 60.0, matrix)], (0.0, -0.9, 1.5), (0.0, 0.5, 0.3),
+                      world=(0.05, 0.07, 0.1))

@@ -12,8 +12,7 @@
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;  // gl/bind.VOLUME_GROUP
 uniform ivec3 u_grid_size;
 uniform sampler3D u_area;        // voxelize(): rgb projected areas (m²), a total area
-uniform usampler3D u_acc;        // vct/inject_raster.glsl MODE_ALBEDO's sums (float bits)
-#define ACC_CHANNELS 4           // Σ w·albedo (rgb), Σ w: vct/inject_raster.glsl's in MODE_ALBEDO
+uniform usampler3D u_acc;        // vct/inject_raster.glsl MODE_ALBEDO's sums (float bits), ACC_CHANNELS a face
 layout(rgba16f, binding = 0) uniform writeonly image3D u_out[6];       // +x, −x, +y, −y, +z, −z
 #include "vct/arrays.glsl"
 VCT_STORE6(store_out, u_out)

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// VCT radiance injection, compute half (the surface points are rasterised by vct/inject_raster.glsl).
+// VCT light injection, compute half (the surface points are rasterised by vct/inject_raster.glsl).
 //
 // Per direction, not per side of the voxel normal: the voxelizer's normal is a mean of sign-canonicalised normals,
 // which says nothing about which side faces a room at an edge or corner voxel (floor + wall average to a diagonal
@@ -78,7 +78,7 @@ layout(std430, binding = 3) buffer Count { uint fallback_count; };   // gl/bind.
 uniform uint u_capacity;   // entries the list holds: the count goes on past it (vct/inject.py makes it larger)
 
 float acc(int g, ivec3 v, int c) {
-    return uintBitsToFloat(texelFetch(u_acc, ivec3(8 * v.x + c, v.y, g * u_grid_size.z + v.z), 0).r);
+    return uintBitsToFloat(texelFetch(u_acc, ivec3(ACC_CHANNELS * v.x + c, v.y, g * u_grid_size.z + v.z), 0).r);
 }
 
 // The projected area along `axis` that voxel v's surface covers in its column: its own, plus its two neighbours'

@@ -101,12 +101,8 @@ layout(r32ui, binding = 2) coherent uniform uimage3D u_front_y;
 layout(r32ui, binding = 3) coherent uniform uimage3D u_front_z;
 #define FRONT_TOLERANCE 66u         // 1/1000 of a cell: coplanar pieces (shared edges, duplicates) all count
 // Accumulator: channel c (0–2 Σw·E/π or, MODE_ALBEDO, Σw·albedo; 3 Σw; 4–6 Σw·p, not in MODE_ALBEDO) of face g of
-// voxel v at (ACC_CHANNELS·v.x + c, v.y, g·nz + v.z).
-#if defined(MODE_ALBEDO)
-#define ACC_CHANNELS 4
-#else
-#define ACC_CHANNELS 8
-#endif
+// voxel v at (ACC_CHANNELS·v.x + c, v.y, g·nz + v.z); ACC_CHANNELS is defined by vct/inject.py (LIGHT_SUMS or
+// ALBEDO_SUMS).
 layout(r32ui, binding = 0) coherent uniform uimage3D u_acc;
 
 void add_float(ivec3 t, float x) {
