@@ -16,14 +16,16 @@ from .vct.settings import VctSettings
 
 METHODS = ("none", "lpv", "vct")
 # GPU memory a method's volumes take: bytes per voxel plus a fixed part, every texture and buffer a render allocates
-# included (tallied over renders at 16³–48³: VCT 912 B of 3D textures + ≤ 25 B of buffers per voxel of its padded
+# included (tallied over renders at 16³–48³: VCT 928 B of 3D textures — 912 before its faces' albedo, 48 B, came and
+# the voxelizer's albedo and emission, 32 B, went — + ≤ 25 B of buffers per voxel of its padded
 # grid; LPV ≤ 1976 B of 3D textures (its geometry volume at twice the resolution included) + 170–320 B of buffers per
 # cell of each cascade, and ≈ 4 MB of VPL buffers at any size; the LPV's three voxelisations per axis
 # (lpv/receivers.py) are held one at a time). tests/stress/test_grids_bounces.py holds these to the peak of what a
 # render holds at once, so a volume added but not counted here fails a test. VCT's injection adds its cover
-# test's front-most images (vct/inject.front_bytes, sized by the grid's largest side), and its recorded cone samples
-# (vct/replay.pool_bytes, sized by the surface area and the traced image).
-VCT_BYTES_PER_VOXEL, VCT_FIXED_BYTES = 940, 2 ** 20
+# test's front-most images (vct/inject.front_bytes, sized by the grid's largest side), the lights' parts it sums
+# (vct/parts.parts_bytes) and its recorded cone samples (vct/replay.pool_bytes, sized by the surface area and the
+# traced image).
+VCT_BYTES_PER_VOXEL, VCT_FIXED_BYTES = 956, 2 ** 20
 LPV_BYTES_PER_CELL, LPV_FIXED_BYTES = 2300, 8 * 2 ** 20
 # A triangle is degenerate when twice its area is below this fraction of its longest edge squared: its height is
 # under 2⁻²³ of that edge, float32's rounding of its corners.
