@@ -5,7 +5,8 @@ A sunlit floor (white) under a red rug of the same size 1 mm above it, and a whi
 indirect light comes from the rug alone, so its colour is the rug's (green/red = 0.1/0.7) and its level the rug's
 radiance times the view factor. Without the cover test (vct/inject_raster.glsl) the floor's white radiance is
 averaged into the same voxel faces: measured green/red 0.600 instead of the rug's 0.143 (the issue's "grey bounce");
-with it 0.145, and the level 1.02 of the view-factor integral. The later bounces reflect with each face's own albedo
+with it 0.143 (0.145 while the injection summed each point's albedo times its light), and the level 1.01 of the
+view-factor integral (1.02). The later bounces reflect with each face's own albedo
 (tests/gpu/test_vct_face_albedo.py), so they too are the visible surface's.
 """
 import math
