@@ -7,10 +7,12 @@ occupancy in the voxel data so a material edit never re-voxelizes").
 The materials here are plain Lambert ones (no Principled layers), whose transport albedo is their base colour, so
 each face's expected albedo is a colour of the scene. Stored as float16: within 2⁻¹¹ relative, 1e-3 absolute."""
 import numpy as np
+import pytest
 
 from bounce_gi.gpu_kernels.engine import Engine
 from bounce_gi.gpu_kernels.scene import Light, Material
 from bounce_gi.gpu_kernels.settings import RenderSettings
+from bounce_gi.gpu_kernels.vct import parts
 from bounce_gi.gpu_kernels.vct.settings import VctSettings
 from bounce_gi.gpu_kernels.vct.trace import read_level
 from support.lpv_transfer import rerun
@@ -69,24 +71,30 @@ def test_each_face_reflects_its_own_surface():
             assert np.allclose(faces[PZ][v][:3], WHITE, atol=FLOAT16), (v, faces[PZ][v])
 
 
-def test_a_colour_edit_keeps_the_voxels_and_the_light():
+@pytest.mark.parametrize("apart", [True, False], ids=["parts", "all lights at once"])
+def test_a_colour_edit_keeps_the_voxels_and_the_light(monkeypatch, apart):
     """The block recoloured: only the faces' albedo, the sum of the parts and what follows them run again — not the
-    voxelisation, the geometry's parts or any part's injection — and the image is what a render from scratch of the
-    recoloured room gives. Tolerance 1e-6 of the pass's largest value: both sum the same parts in the same order,
-    what may differ is the order of the injection's compare-and-swap adds (measured 0 on llvmpipe)."""
+    voxelisation, the geometry's parts or any part's injection (the lamp's and the sky's, or, where the parts would
+    not fit, the one of every light) — and the image is what a render from scratch of the recoloured room gives.
+    Tolerance 1e-6 of the pass's largest value: both sum the same parts in the same order, what may differ is the
+    order of the injection's compare-and-swap adds (measured 0 on llvmpipe)."""
+    if not apart:
+        monkeypatch.setattr(parts, "PART_BYTES_CAP", 0)
+    injected = {"vct_inject_lamps", "vct_inject_sky"} if apart else {"vct_inject_all"}
     engine, fresh = Engine(), Engine()
     try:
-        engine.render(open_room_with_block(), SETTINGS)
+        first = engine.render(open_room_with_block(), SETTINGS)
+        assert injected <= set(rerun(first)), rerun(first)
         edited = engine.render(open_room_with_block(block=(0.9, 0.3, 0.1)), SETTINGS)
         ran = set(rerun(edited))
         assert {"vct_albedo", "vct_inject", "vct_bounce"} <= ran, ran
-        assert not ran & {"vct_voxelize", "vct_geometry", "vct_inject_lamps", "vct_inject_sky"}, ran
+        assert not ran & ({"vct_voxelize", "vct_geometry"} | injected), ran
         cold = fresh.render(open_room_with_block(block=(0.9, 0.3, 0.1)), SETTINGS)
         for name in ("Diffuse Indirect", "Combined"):
             a, b = edited.passes[name], cold.passes[name]
             assert np.abs(a - b).max() <= 1e-6 * float(np.abs(b).max()), name
         before = engine.render(open_room_with_block(), SETTINGS)  # and back: the light kept
-        assert not set(rerun(before)) & {"vct_voxelize", "vct_inject_lamps", "vct_inject_sky"}
+        assert not set(rerun(before)) & ({"vct_voxelize"} | injected)
     finally:
         engine.shutdown()
         fresh.shutdown()
