@@ -36,7 +36,7 @@ def _render(monkeypatch, room=None):
         return counts[-1]
     monkeypatch.setattr(inject, "dispatch_counted", spy)
     if room is not None:
-        monkeypatch.setattr(inject, "FALLBACK_ROOM", room)
+        monkeypatch.setattr(inject, "LISTED_ROOM", room)
     engine = Engine()
     try:
         result = engine.render(_room(), SETTINGS)
@@ -56,7 +56,8 @@ def _render(monkeypatch, room=None):
 def test_every_fallback_face_is_listed_and_lit(monkeypatch):
     lit, where, counts, result, grid = _render(monkeypatch)
     fallback = where < 0  # vct/inject.glsl: a fallback face's centroid has w = −α
-    assert counts == [int(fallback.sum())] == [result.info["faces_without_samples"]]
+    # Listed twice, the same faces: by the albedo's resolve (vct/face_albedo.glsl) and by the light's.
+    assert counts == [int(fallback.sum())] * 2 and counts[0] == result.info["faces_without_samples"]
     # Lit at the face's centre, n·cell/2 out of the voxel: those of the slab's sides, inside the room and facing the
     # lamp, get its light (nothing stands between); those whose point lies outside the room's walls get none.
     lamp = np.array([-0.3, 0.2, 1.5])
@@ -79,7 +80,7 @@ def test_every_fallback_face_is_listed_and_lit(monkeypatch):
 def test_a_list_too_small_is_made_again(monkeypatch):
     lit, where, counts, _, _ = _render(monkeypatch)
     small_lit, small_where, small_counts, _, _ = _render(monkeypatch, room=1)
-    assert small_counts == [counts[0], counts[0]]  # counted past the room, then listed in full
+    assert small_counts == [counts[0]] * 4  # each list counted past the room, then made in full
     assert np.array_equal(where < 0, small_where < 0)
     # the same light: the injection's float sums may differ in the last bit from run to run (vct/inject_raster.glsl)
     assert np.allclose(small_lit, lit, rtol=1e-5, atol=1e-7 * float(lit.max()))

@@ -8,8 +8,7 @@
 // its floor faces, and a rug over a floor the rug's colour only.
 // A face with coverage (projected area on its axis) but no raster sample — a sliver thinner than the raster's
 // pixels, which vct/inject.glsl lights at its centre — takes the mean of the same face of its 26 neighbours (the
-// rest of its surface), else of its own voxel's other faces, else 0.
-layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;  // gl/bind.VOLUME_GROUP
+// rest of its surface), else of its own voxel's other faces, else 0 (MODE_SLIVERS, over the list the resolve makes).
 uniform ivec3 u_grid_size;
 uniform sampler3D u_area;        // voxelize(): rgb projected areas (m²), a total area
 uniform usampler3D u_acc;        // vct/inject_raster.glsl MODE_ALBEDO's sums (float bits), ACC_CHANNELS a face
@@ -33,20 +32,47 @@ vec4 neighbours(int g, ivec3 v) {
     return sum;
 }
 
+#if defined(MODE_SLIVERS)
+// The listed faces, one per invocation: the mean of the same face of the 26 neighbours, else of the voxel's other
+// faces, else 0.
+layout(local_size_x = 64) in;
+layout(std430, binding = 5) readonly buffer Slivers { ivec4 slivers[]; };   // voxel, face g
+uniform int u_first;   // this dispatch's first entry (at most 65535 groups a dispatch)
+uniform int u_count;   // entries in the list
+
+void main() {
+    int i = u_first + int(gl_GlobalInvocationID.x);
+    if (i >= u_count) return;
+    ivec3 v = slivers[i].xyz;
+    int g = slivers[i].w;
+    vec4 s = neighbours(g, v);
+    for (int f = 0; f < 6 && s.w <= 0.0; ++f) s += sums(f, v);   // none around: the voxel's own other faces
+    store_out(g, v, vec4(s.w > 0.0 ? s.rgb / s.w : vec3(0.0), 1.0));
+}
+#else
+// Each covered face with samples gets their mean; a covered face without (a sliver) is listed for MODE_SLIVERS,
+// whose neighbour search, run here, every lane of a SIMD group would have paid for its few slivers. Faces without
+// coverage keep the zeros the images start with (gl/bind.texture3d): nothing reads them (vct/bounce.py gathers at
+// covered faces, vct/inject_sum.glsl multiplies covered ones).
+layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;  // gl/bind.VOLUME_GROUP
+layout(std430, binding = 3) buffer Count { uint sliver_count; };   // gl/bind.dispatch_counted
+layout(std430, binding = 5) writeonly buffer Slivers { ivec4 slivers[]; };
+uniform uint u_capacity;   // entries the list holds: the count goes on past it (vct/inject.py makes it larger)
+
 void main() {
     ivec3 v = ivec3(gl_GlobalInvocationID);
     if (any(greaterThanEqual(v, u_grid_size))) return;
     vec4 area = texelFetch(u_area, v, 0);
-    if (area.a <= 0.0) return;   // the images start zeroed (gl/bind.texture3d)
-    vec4 face[6], own = vec4(0.0);
+    if (area.a <= 0.0) return;
     for (int g = 0; g < 6; ++g) {
-        face[g] = sums(g, v);
-        own += face[g];
-    }
-    for (int g = 0; g < 6; ++g) {
-        vec4 s = face[g];
-        if (s.w <= 0.0 && area[g >> 1] > 0.0) s = neighbours(g, v);
-        if (s.w <= 0.0) s = own;
-        store_out(g, v, vec4(s.w > 0.0 ? s.rgb / s.w : vec3(0.0), 1.0));
+        if (!(area[g >> 1] > 0.0)) continue;
+        vec4 s = sums(g, v);
+        if (s.w > 0.0) {
+            store_out(g, v, vec4(s.rgb / s.w, 1.0));
+        } else {
+            uint i = atomicAdd(sliver_count, 1u);
+            if (i < u_capacity) slivers[i] = ivec4(v, g);
+        }
     }
 }
+#endif
