@@ -16,7 +16,6 @@ from dataclasses import replace
 import numpy as np
 
 from ..gl.bind import ssbo
-from ..scene import hash_parts
 
 
 def colour_scale(shadows) -> np.ndarray:
@@ -31,18 +30,12 @@ def largest_colour(colours: np.ndarray) -> np.ndarray:
     return np.where(largest > 0, largest, np.float32(1.0))
 
 
-def unit_records(shadows, scale: np.ndarray, lights=None) -> np.ndarray:
-    """The light records (those at the indices `lights`, or all) with their colours divided by `scale` (what
-    vct_inject lights the voxels with)."""
-    records = (shadows.buffers.lights if lights is None else shadows.buffers.lights[lights]).copy()
+def unit_records(shadows, scale: np.ndarray, lights: np.ndarray) -> np.ndarray:
+    """The light records at the indices `lights` with their colours divided by `scale` (what a part of vct_inject
+    lights the voxels with, vct/parts.py)."""
+    records = shadows.buffers.lights[lights].copy()
     records["color_type"][:, :3] /= scale
     return records
-
-
-def unit_key(shadows, records: np.ndarray) -> str:
-    """What vct_inject's light is made of: the maps and records but for the colours (direct/shadows.views_key) and
-    the divided colours."""
-    return hash_parts(shadows.views_key, records["color_type"][:, :3])
 
 
 def with_records(ctx, shadows, records: np.ndarray, run):

@@ -31,10 +31,10 @@ def inject(ctx, programs, scene: Scene, geometry, textures: list, vox, shadows, 
            shared: VoxelGeometry | None = None, scratch: dict | None = None) -> Faces:
     """Direct light arriving at every voxel face, E/π per unit albedo: surface points rasterised along their
     dominant axis and lit exactly as in direct/light.glsl (vct/inject_raster.glsl), then averaged per face
-    (vct/inject.glsl); `faces.flux` is that light's (W per unit albedo). The faces' centroids are taken from
-    `shared` where it holds them, else made and left there. `scratch` (a dict; none: made and released here) keeps
-    the accumulator and the front-most surfaces for the next injection of the same voxels with other lights
-    (vct/parts.py): the caller releases it (release_scratch)."""
+    (vct/inject.glsl); the statistics (flux, occupied, missed) are taken of the sum (vct/parts.sum_parts). The
+    faces' centroids are taken from `shared` where it holds them, else made and left there. `scratch` (a dict;
+    none: made and released here) keeps the accumulator and the front-most surfaces for the next injection of the
+    same voxels with other lights (vct/parts.py): the caller releases it (release_scratch)."""
     grid = vox.grid
     kept = shared is not None and shared.centroids is not None
     faces = Faces([texture3d(ctx, grid.size, zero=True) for _ in range(6)], grid, levels,
@@ -58,7 +58,6 @@ def inject(ctx, programs, scene: Scene, geometry, textures: list, vox, shadows, 
     finally:
         if own:
             release_scratch(scratch)
-    faces.flux, faces.occupied, faces.missed = face_flux(ctx, programs, faces)
     if shared is not None and not kept:
         shared.centroids, faces.centroids_owned = faces.centroids, False
     return faces

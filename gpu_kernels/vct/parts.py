@@ -100,11 +100,10 @@ def part_key(shadows, part: Part, records: np.ndarray) -> str:
 
 def sum_parts(ctx, programs, parts: list, weights: list, albedo: FaceAlbedo, centroids: list) -> Faces:
     """New faces albedo ⊙ Σ_p weights[p] ⊙ parts[p] (rgb: each part's light per unit albedo; the coverage α, the
-    geometry's, from any part), with the kept `centroids` (not owned), and their flux (the faces the parts lit at
-    their centre and the occupied voxels are the geometry's)."""
+    geometry's, from any part), with the kept `centroids` (not owned), and their statistics (inject.face_flux)."""
     first = parts[0]
     out = Faces([texture3d(ctx, first.grid.size, zero=True) for _ in range(6)], first.grid, first.levels,
-                occupied=first.occupied, centroids=centroids, missed=first.missed, centroids_owned=False)
+                centroids=centroids, centroids_owned=False)
     prog = programs.compute("vct/inject_sum.glsl")
     set_uniform(prog, "u_grid_size", tuple(int(n) for n in first.grid.size))
     set_uniform(prog, "u_parts", len(parts))
@@ -117,5 +116,5 @@ def sum_parts(ctx, programs, parts: list, weights: list, albedo: FaceAlbedo, cen
         texture.bind_to_image(0, read=False, write=True)
         dispatch(prog, first.grid.size)
     ctx.memory_barrier()
-    out.flux = face_flux(ctx, programs, out)[0]
+    out.flux, out.occupied, out.missed = face_flux(ctx, programs, out)
     return out

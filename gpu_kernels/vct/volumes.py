@@ -71,7 +71,8 @@ class FaceAlbedo:
 class Faces:
     """Six RGBA32F 3D textures, one per voxel face (outward normal +x, −x, +y, −y, +z, −z): rgb = outgoing
     radiance through that face (vct/inject.py's own: E/π, the light per unit albedo), a = its coverage α_g
-    (vct/inject.glsl). `flux`: π·cell²·Σ α_g·L_g (W, RGB)."""
+    (vct/inject.glsl). `flux`: π·cell²·Σ α_g·L_g (W, RGB), with `occupied` and `missed`, set on the sum of the
+    injected parts (vct/parts.sum_parts)."""
     textures: list
     grid: Grid
     levels: int  # mip levels the volumes built from these faces get

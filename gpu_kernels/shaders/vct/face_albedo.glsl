@@ -46,7 +46,8 @@ void main() {
     ivec3 v = slivers[i].xyz;
     int g = slivers[i].w;
     vec4 s = neighbours(g, v);
-    for (int f = 0; f < 6 && s.w <= 0.0; ++f) s += sums(f, v);   // none around: the voxel's own other faces
+    if (s.w <= 0.0)   // none around: the mean of the voxel's own other faces
+        for (int f = 0; f < 6; ++f) s += sums(f, v);
     store_out(g, v, vec4(s.w > 0.0 ? s.rgb / s.w : vec3(0.0), 1.0));
 }
 #else
