@@ -294,7 +294,7 @@ class Pipeline:
         kept = self.cache.prior("sky_visibility", lambda k: k[0][1:] == k_sky[0][1:] and k[1] == k_sky[1])
         moved = None if kept is None else self._moved_since(frame, kept.made_from)
         table = None if moved is None else sky.update_table(frame.shadows)
-        return None if table is None else sky.SkyUpdate(kept, moved[0], table, frame.shadows.maps.overwritten.buffer)
+        return None if table is None else sky.SkyUpdate(kept, moved[0], table)
 
     @staticmethod
     def _method_output(frame):

@@ -1,8 +1,9 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """The sky light's visible shares per G-buffer pixel (direct/light.glsl MODE_SKY, direct/sky.glsl): one shadow test
-per direction of the sky, hundreds of them, summed and then averaged over each pixel's penumbra
-(direct/sky_filter.glsl). The pipeline keeps them across light, material and world edits (they depend on the
-G-buffer and the sky's maps only); after an object's move they are updated, not made anew (SkyUpdate)."""
+per direction of the sky, hundreds of them, each cell an opening's edge crosses tested over its cone, and the
+diffuse share then averaged over each pixel's penumbra (direct/sky_filter.glsl). The pipeline keeps them across
+light, material and world edits (they depend on the G-buffer and the sky's maps only); after an object's move only
+the pixels whose tests can read a texel it redrew are made anew (SkyUpdate)."""
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -16,21 +17,21 @@ from .lighting import bind_inputs
 from .shadows import ShadowAtlas
 
 TILE = 8  # pixels per side of a work group of direct/light.glsl: the blocks an update lists directions for
+NEIGHBOURS = 6  # per sky direction, its nearest (direct/sky.glsl SKY_NEIGHBOURS)
 
 
 @dataclass
 class SkyShares:
     """`texture`: RGBA32F, per pixel the shares of the sky's cosine weight (x) and of the glossy lobe's (y) that its
-    directions' tests find visible, and the penumbra's half-width (z, m), filtered; `sums` and `blocked`: the sums
-    they come from (direct/sky.glsl SkySums), unfiltered, which an object's move updates; `made_from`: the depth
-    atlas (serial, generation), the scene's triangles and the G-buffer's key they were made with."""
+    directions' tests find visible, and the penumbra's half-width (z, m), the diffuse share filtered; `raw`: the
+    same unfiltered, which an object's move updates; `made_from`: the depth atlas (serial, generation), the scene's
+    triangles and the G-buffer's key they were made with."""
     texture: object
-    sums: object
-    blocked: object
+    raw: object
     made_from: tuple = None
 
     def release(self):
-        for t in (self.texture, self.sums, self.blocked):
+        for t in (self.texture, self.raw):
             t.release()
 
 
@@ -38,13 +39,11 @@ class SkyShares:
 class SkyUpdate:
     """What an object's move leaves of an earlier SkyShares of the same G-buffer (but where the move covers it) and
     sky, made from the depth atlas one update ago: `pixels` (x0, y0, x1, y1) the G-buffer rectangle the moved
-    triangles can cover (made anew there), `table` (K, 2, 4) int32 per sky direction the box of the texels its
-    redraw changed and where those it overwrote were kept (direct/sky.glsl SkyRedrawn), `texels` the buffer holding
-    them."""
+    triangles can cover (made anew there), `table` (K, 4) int32 per sky direction the box of the texels its redraw
+    changed (direct/sky.glsl SkyRedrawn)."""
     prior: SkyShares
     pixels: tuple
     table: np.ndarray
-    texels: object
 
 
 def sky_light(shadows: ShadowAtlas) -> int | None:
@@ -57,38 +56,48 @@ def sky_light(shadows: ShadowAtlas) -> int | None:
 def render_sky_visibility(ctx, programs, gbuffer: GBuffer, shadows: ShadowAtlas, material_lut=None,
                           update: SkyUpdate | None = None) -> SkyShares | None:
     """The sky light's SkyShares, or None where the scene has no sky light. With `update`, a pixel outside its
-    moved rectangle takes its earlier sums and does again only the tests that read a texel the move redrew: the
-    same sums as testing every direction, to float32 rounding (tests/gpu/test_sky_update.py)."""
-    if sky_light(shadows) is None:
+    moved rectangle whose tests read no texel the move redrew keeps its earlier shares: the same shares as a cold
+    render (tests/gpu/test_sky_update.py)."""
+    sky = sky_light(shadows)
+    if sky is None:
         return None
     w, h = gbuffer.size
-    shares, sums, blocked = (ctx.texture((w, h), 4, dtype="f4") for _ in range(3))
+    raw = ctx.texture((w, h), 4, dtype="f4")
     prog = programs.compute("direct/light.glsl", {"MODE_SKY": None, **shadows.defines})
-    for binding, tex in ((2, shares), (3, sums), (4, blocked)):
-        tex.bind_to_image(binding, read=False, write=True)
+    raw.bind_to_image(2, read=False, write=True)
     unit = bind_inputs(prog, gbuffer, shadows, material_lut)
     set_uniforms(prog, {"u_sky_update": update is not None,
                         "u_moved_pixels": tuple(update.pixels) if update else (0, 0, 0, 0)})
+    first, count = (int(v) for v in shadows.buffers.lights[sky]["params"][1:3])
     buffers = []
     if update is not None:
-        unit = bind_samplers(prog, "u_sky_sums_prior", [update.prior.sums], unit)
-        bind_samplers(prog, "u_sky_blocked_prior", [update.prior.blocked], unit)
+        bind_samplers(prog, "u_sky_prior", [update.prior.raw], unit)
         buffers.append(ssbo(ctx, update.table))
         buffers[0].bind_to_storage_buffer(11)  # read by tile_directions too
         buffers.append(tile_directions(ctx, programs, gbuffer, shadows, update))
         bind_light_records(shadows)
         buffers[1].bind_to_storage_buffer(13)
-        update.texels.bind_to_storage_buffer(12)
         set_uniforms(prog, {"u_tiles_x": -(-w // TILE), "u_sky_words": -(-len(update.table) // 32)})
+    buffers.append(ssbo(ctx, neighbours(shadows.buffers.views[first:first + count])))
+    buffers[-1].bind_to_storage_buffer(14)  # after tile_directions, whose output binds there
     dispatch(prog, (w, h), local=TILE)
     for buffer in buffers:
         buffer.release()
-    return SkyShares(filter_sky_shares(ctx, programs, gbuffer, shares), sums, blocked)
+    return SkyShares(filter_sky_shares(ctx, programs, gbuffer, raw), raw)
+
+
+def neighbours(views: list) -> np.ndarray:
+    """(K, NEIGHBOURS) int32: per sky direction (its view's emit_normal), the indices of its nearest others."""
+    dirs = np.array([v.emit_normal for v in views], np.float64).reshape(-1, 3)
+    if len(dirs) <= NEIGHBOURS:
+        return np.zeros((len(dirs), NEIGHBOURS), np.int32)
+    near = np.argpartition(-(dirs @ dirs.T), NEIGHBOURS, axis=1)[:, :NEIGHBOURS + 1]
+    return np.array([[j for j in row if j != i][:NEIGHBOURS] for i, row in enumerate(near)], np.int32)
 
 
 def tile_boxes(gbuffer: GBuffer, moved: tuple) -> np.ndarray:
     """(tiles, 2, 4) float32: per TILE × TILE block of pixels (row by row), the box (lo, hi) of the G-buffer points
-    an update takes out and adds back tests at — those outside the `moved` rectangle (x0, y0, x1, y1); an empty box
+    an update may keep — those outside the `moved` rectangle (x0, y0, x1, y1); an empty box
     (lo > hi) where there are none."""
     w, h = gbuffer.size
     position = read_texture(gbuffer.textures["position"])[::-1]  # (h, w, 4), row 0 the texels' y = 0
@@ -129,7 +138,8 @@ def tile_directions(ctx, programs, gbuffer: GBuffer, shadows: ShadowAtlas, updat
 
 def update_table(shadows: ShadowAtlas) -> np.ndarray | None:
     """SkyUpdate.table for the sky light's directions from the depth atlas's last update (shadows.maps: redrawn,
-    overwritten); None where it cannot serve: a sky view drawn whole, or its overwritten texels not kept."""
+    and which of the texels each redraw overwrote it changed); None where it cannot serve: a sky view drawn whole,
+    or its overwritten texels not kept (what changed in it is not known)."""
     maps = shadows.maps
     if maps is None or maps.redrawn is None or maps.overwritten is None:
         return None
@@ -137,32 +147,33 @@ def update_table(shadows: ShadowAtlas) -> np.ndarray | None:
     if sky is None:
         return None
     first, count = (int(v) for v in shadows.buffers.lights[sky]["params"][1:3])
-    table = np.zeros((count, 2, 4), np.int32)
+    table = np.zeros((count, 4), np.int32)
     kept, changed = maps.overwritten.rects, maps.overwritten.changed
     for view, rect in maps.redrawn:
         if not first <= view < first + count:
             continue
         if rect is None or view not in kept:
             return None
-        x, y, w, h, start = kept[view]
-        table[view - first] = (changed[view] or (0, 0, 0, 0), (start, w, x, y))
+        table[view - first] = changed[view] or (0, 0, 0, 0)
     return table
 
 
 def filter_sky_shares(ctx, programs, gbuffer: GBuffer, shares):
-    """The sky's shares averaged over each pixel's penumbra on its own surface, one image axis at a time
-    (direct/sky_filter.glsl); releases `shares`."""
+    """The sky's diffuse share averaged over each pixel's penumbra on its own surface, one image axis at a time
+    (direct/sky_filter.glsl); keeps `shares`."""
     w, h = gbuffer.size
     prog = programs.compute("direct/sky_filter.glsl")
     unit = bind_samplers(prog, "u_position", [gbuffer.textures["position"]], 0)
     unit = bind_samplers(prog, "u_geo_normal", [gbuffer.textures["geo_normal"]], unit)
     set_uniform(prog, "u_size", (w, h))
+    source = shares
     for axis in ((1, 0), (0, 1)):
         out = ctx.texture((w, h), 4, dtype="f4")
-        bind_samplers(prog, "u_shares", [shares], unit)
+        bind_samplers(prog, "u_shares", [source], unit)
         out.bind_to_image(0, read=False, write=True)
         set_uniform(prog, "u_axis", axis)
         dispatch(prog, (w, h), local=8)
-        shares.release()
-        shares = out
-    return shares
+        if source is not shares:
+            source.release()
+        source = out
+    return source

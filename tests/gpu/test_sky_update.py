@@ -1,9 +1,9 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""The sky's visibility after an object's move (direct/sky.py SkyUpdate): each pixel takes the sums it had and does
-again only the tests of the directions whose maps the move redrew where they can read a redrawn texel — the old
-result of each (from the depths the redraw overwrote, direct/shadows.keep_texels) taken out, the new one added.
-Against a cold render of the moved scene: the same Diffuse and Glossy Direct to float32 rounding of the sums
-(1e-5 of the image's mean: a test taken out with the wrong texels is a whole direction's share, 1/64 here)."""
+"""The sky's visibility after an object's move (direct/sky.py SkyUpdate): a pixel whose tests (the four texels of
+each direction, the edge cells' cones up to direct/eval.glsl sky_reach beyond them) can read a texel the move
+redrew, or that the moved object can cover, is made anew; every other keeps its shares of one update ago. Against
+a cold render of the moved scene: the same Diffuse and Glossy Direct to float32 rounding (1e-5 of the image's
+mean: a pixel kept that should have been made anew is off by a whole direction's share, 1/64 here)."""
 import numpy as np
 
 from bounce_gi.gpu_kernels.common.lights import ShadowSettings

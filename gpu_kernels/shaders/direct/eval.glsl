@@ -249,12 +249,18 @@ float polygon_visibility(GpuLight L, vec3 p, vec3 n, vec3 geo_n) {
 }
 
 // Direction k of the sky light (ShadowView.emitter: d_k and its solid angle) as a surface of geometric normal
-// geo_n sees it: false for directions below the surface (they see its back) and grazing ones (cos < 0.1: 1% of the
-// irradiance), which would need an offset larger than a thin wall is thick; those take the others' mean (left out
-// of both the weights and the visible sum).
+// geo_n sees it: false for directions below the surface (they see its back) and grazing ones (cos < SKY_MIN_COS: 1%
+// of the irradiance), which would need an offset larger than a thin wall is thick; those take the others' mean (left
+// out of both the weights and the visible sum).
+#define SKY_MIN_COS 0.02
 bool sky_direction(GpuLight L, int k, vec3 geo_n, out vec3 d) {
     d = shadow_views[int(L.params.y) + k].emitter.xyz;
-    return dot(geo_n, d) >= 0.1;
+    return dot(geo_n, d) >= SKY_MIN_COS;
+}
+
+// The angular radius of a sky direction's cell: a disc of the cell's solid angle 4π/K.
+float sky_cell_radius(int samples) {
+    return 2.0 / sqrt(float(samples));
 }
 
 // Metres per unit of an orthographic map's stored depth (its z is linear over its near–far span: 2 / |∇ ndc.z| of
@@ -262,6 +268,12 @@ bool sky_direction(GpuLight L, int k, vec3 geo_n, out vec3 d) {
 float ortho_depth_scale(int view_index) {
     mat4 m = shadow_views[view_index].view_projection;
     return 2.0 / length(vec3(m[0][2], m[1][2], m[2][2]));
+}
+
+// How far (atlas texels) a sky cell's cone reads around its ray's texel in its map (direct/sky.glsl
+// sky_cone_taps): the cell's radius at the farthest blocker the map can hold, its whole depth span.
+float sky_reach(int view, int samples) {
+    return tan(sky_cell_radius(samples)) * ortho_depth_scale(view) / shadow_views[view].info.x;
 }
 
 // Visibility of the sky light from its K directions d_k: the share of the cosine weight max(0, n·d_k) of the

@@ -33,12 +33,10 @@ uniform bool u_sky_cached;
 uniform sampler2D u_sky_shares;
 #if defined(MODE_SKY)
 layout(rgba32f, binding = 2) uniform writeonly image2D u_sky_out;     // shares (direct/sky.glsl sky_result)
-layout(rgba32f, binding = 3) uniform writeonly image2D u_sky_sums;    // SkySums.weights
-layout(rgba32f, binding = 4) uniform writeonly image2D u_sky_blocked; // SkySums.penumbra
-// After an object's move (direct/sky.py): the sums of one update ago, updated outside u_moved_pixels
+// After an object's move (direct/sky.py): the shares of one update ago, kept outside u_moved_pixels where no test
+// reads a texel the move redrew (direct/sky.glsl sky_reads_redrawn)
 uniform bool u_sky_update;
-uniform sampler2D u_sky_sums_prior;
-uniform sampler2D u_sky_blocked_prior;
+uniform sampler2D u_sky_prior;
 #endif
 // After an object's move (direct/lighting.Relight) only the pixels it can change are lit again: those inside
 // u_moved_pixels (x0, y0, x1, y1: where the moved triangles can cover the G-buffer) and those whose shadow tests can
@@ -115,8 +113,6 @@ void main() {
     if (pos.w < 0.5) {
 #if defined(MODE_SKY)
         imageStore(u_sky_out, px, vec4(0.0));
-        imageStore(u_sky_sums, px, vec4(0.0));
-        imageStore(u_sky_blocked, px, vec4(0.0));
 #else
         imageStore(u_diffuse_direct, px, vec4(0.0, 0.0, 0.0, 1.0));
         imageStore(u_glossy_direct, px, vec4(0.0, 0.0, 0.0, 1.0));
@@ -139,19 +135,13 @@ void main() {
     GlossyLobe lobe = GlossyLobe(glossy.w * glossy.w, int(spec.w + 0.5), dot(n, v), spec.rgb);
     bool lobe_seen = has_glossy && lobe.mu > 0.0;
 #if defined(MODE_SKY)
-    SkySums sums = SkySums(vec4(0.0), vec2(0.0));
     vec3 sky = vec3(0.0);
     for (int i = 0; i < u_light_count; ++i)
-        if (int(lights[i].color_type.w) == LIGHT_SKY) {
-            sums = updated
-                ? sky_sums_update(SkySums(texelFetch(u_sky_sums_prior, px, 0), texelFetch(u_sky_blocked_prior, px,
-                                  0).xy), lights[i], pos.xyz, n, geo_n, lobe, v, lobe_seen)
-                : sky_sums(lights[i], pos.xyz, n, geo_n, lobe, v, lobe_seen);
-            sky = sky_result(sums, int(lights[i].params.z));
-        }
+        if (int(lights[i].color_type.w) == LIGHT_SKY)
+            sky = updated && !sky_reads_redrawn(lights[i], pos.xyz, geo_n)
+                ? texelFetch(u_sky_prior, px, 0).xyz
+                : sky_result(sky_sums(lights[i], pos.xyz, n, geo_n, lobe, v, lobe_seen), int(lights[i].params.z));
     imageStore(u_sky_out, px, vec4(sky, 0.0));
-    imageStore(u_sky_sums, px, sums.weights);
-    imageStore(u_sky_blocked, px, vec4(sums.penumbra, 0.0, 0.0));
     return;
 #endif
     vec3 irradiance = vec3(0.0), reflected = vec3(0.0), world = vec3(0.0);

@@ -1,13 +1,14 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The sky's visible shares (direct/light.glsl MODE_SKY) averaged along one image axis over each pixel's penumbra,
-// on its own surface only. The sky is shadowed from K fixed directions, each a hard test, so where an opening's edge
-// shadows a floor the share steps once per direction — bands of 1/N of the light where N directions see the sky.
-// Each direction really stands for a cone of half-width h = √(4π/K)/2, whose shadow edge fades over h × the
-// blocker's distance on the receiver: a box of that half-width around the pixel, on the receiver's plane, turns
-// each step into that ramp (as percentage-closer soft shadows widen a filter by the blocker's distance: Fernando
-// 2005, "Percentage-closer soft shadows"). Filtering over the visible surface rather than in each direction's
-// shadow map keeps the light from leaking through a thin wall beside the receiver: only pixels on the receiver's
-// own plane (position and normal: a bilateral filter, Tomasi and Manduchi 1998) are averaged. Run once per axis.
+// The sky's diffuse share (direct/light.glsl MODE_SKY) averaged along one image axis over each pixel's penumbra, on
+// its own surface only. Each sky direction stands for a cone of half-width h = √(4π/K)/2 whose shadow edge fades
+// over h × the blocker's distance on the receiver; the cells an edge crosses are already tested over their cones
+// (direct/sky.glsl sky_soften), and a box of that half-width around the pixel, on the receiver's plane, smooths
+// what is left of their steps (as percentage-closer soft shadows widen a filter by the blocker's distance: Fernando
+// 2005, "Percentage-closer soft shadows"). The glossy share is left as tested: a glossy reflection of a window is
+// as sharp as the lobe, and averaging it over the penumbra blurred it. Filtering over the visible surface rather
+// than in each direction's shadow map keeps the light from leaking through a thin wall beside the receiver: only
+// pixels on the receiver's own plane (position and normal: a bilateral filter, Tomasi and Manduchi 1998) are
+// averaged. Run once per axis.
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(rgba32f, binding = 0) uniform writeonly image2D u_out;
 uniform sampler2D u_shares;     // x, y: the shares; z: the penumbra's half-width (m); w unused
@@ -59,14 +60,14 @@ void main() {
     int taps = dense ? int(floor(radius + 1e-3)) : MAX_TAPS;
     float stride = dense ? 1.0 : radius / float(MAX_TAPS);
     float slack = PLANE_SLACK * half_width + 2.0 * footprint;
-    vec2 sum = centre.xy;
+    float sum = centre.x;
     float count = 1.0;
     for (int i = -taps; i <= taps; ++i) {
         if (i == 0) continue;
         ivec2 q = px + u_axis * int(round(float(i) * stride));
         if (!on_surface(q, p, n, slack, pq) || length(pq.xyz - p) > 1.5 * half_width) continue;
-        sum += texelFetch(u_shares, q, 0).xy;
+        sum += texelFetch(u_shares, q, 0).x;
         count += 1.0;
     }
-    imageStore(u_out, px, vec4(sum / count, half_width, 0.0));
+    imageStore(u_out, px, vec4(sum / count, centre.y, half_width, 0.0));
 }
