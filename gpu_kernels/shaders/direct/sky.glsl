@@ -90,10 +90,10 @@ vec4 sky_cone_taps(int view, vec3 p, vec3 n, vec3 geo_n, vec3 d, float g, int k,
     vec2 uv0;
     float depth;
     vec4 sum = vec4(0.0);
-    if (!view_uv_depth_biased(sv, p, geo_n, d, 0.0, uv0, depth)) return sum;
-    vec3 q = biased_point(sv, p, geo_n, d, 0.0);
-    float scale = ortho_depth_scale(view);
-    float beyond = depth - SKY_SLAB * g / scale;
+    if (!view_uv_depth_biased(sv, p, geo_n, uv0, depth)) return sum;
+    vec3 q = biased_point(sv, p, geo_n);
+    vec2 slope = receiver_slope(sv, q, geo_n, uv0, depth);
+    float beyond = depth - SKY_SLAB * g / ortho_depth_scale(view);
     float radius = g * tan(cell);
     vec3 t1 = normalize(cross(d, abs(d.z) < 0.9 ? vec3(0.0, 0.0, 1.0) : vec3(1.0, 0.0, 0.0)));
     vec3 t2 = cross(d, t1);
@@ -105,11 +105,10 @@ vec4 sky_cone_taps(int view, vec3 p, vec3 n, vec3 geo_n, vec3 d, float g, int k,
         if (dot(geo_n, di) < SKY_MIN_COS) continue;
         vec2 w = sky_direction_weights(di, n, lobe, fresnel, a2, v, lobe_seen);
         vec4 clip = sv.view_projection * vec4(q + o, 1.0);
-        vec2 uv = clip.xy * 0.5 + 0.5;
-        float plane = depth + dot(geo_n, o) / max(dot(geo_n, d), SKY_MIN_COS) / scale;
+        vec2 uv = sv.tile.xy + (clip.xy * 0.5 + 0.5) * sv.tile.zw;
         float seen = 1.0;   // outside the map: nothing blocks it
-        if (all(greaterThanEqual(uv, vec2(0.0))) && all(lessThanEqual(uv, vec2(1.0))))
-            seen = texture(u_shadow_atlas, vec3(clamp(sv.tile.xy + uv * sv.tile.zw, lo, hi), min(beyond, plane)));
+        if (all(greaterThanEqual(uv, sv.tile.xy)) && all(lessThanEqual(uv, sv.tile.xy + sv.tile.zw)))
+            seen = texture(u_shadow_atlas, vec3(clamp(uv, lo, hi), min(beyond, depth + dot(slope, uv - uv0))));
         sum += vec4(w, w * seen);
     }
     return sum / float(SKY_TAPS);
@@ -118,7 +117,7 @@ vec4 sky_cone_taps(int view, vec3 p, vec3 n, vec3 geo_n, vec3 d, float g, int k,
 // How far (m) in front of p the nearest texel of direction view's test lies; 0 where none does.
 float sky_gap(int view, vec3 p, vec3 geo_n) {
     float gap;
-    view_test(view, p, geo_n, shadow_views[view].emitter.xyz, 0.0, gap);
+    view_test(view, p, geo_n, gap);
     return max(gap, 0.0) * ortho_depth_scale(view);
 }
 
@@ -171,7 +170,7 @@ SkySums sky_sums(GpuLight L, vec3 p, vec3 n, vec3 geo_n, GlossyLobe lobe, vec3 v
         if (counted) {
             s.weights.xy += w;
             float gap;
-            seen = view_test(first + k, p, geo_n, d, 0.0, gap);
+            seen = view_test(first + k, p, geo_n, gap);
             s.weights.zw += w * seen;
             if (gap > 0.0 && w.x > 0.0) s.penumbra += vec2(w.x / (gap * ortho_depth_scale(first + k)), w.x);
         }
@@ -231,7 +230,7 @@ bool sky_reads_redrawn(GpuLight L, vec3 p, vec3 geo_n) {
         ShadowView sv = shadow_views[view];
         vec2 atlas_uv;
         float depth;
-        if (!view_uv_depth_biased(sv, p, geo_n, sv.emitter.xyz, 0.0, atlas_uv, depth)) continue;
+        if (!view_uv_depth_biased(sv, p, geo_n, atlas_uv, depth)) continue;
         vec2 t = gather_point(sv, atlas_uv) / u_atlas_texel - 0.5;
         float reach = sky_reach(view, samples) + 1.0;
         ivec4 r = sky_redrawn[k];
