@@ -8,6 +8,10 @@
 
 
 #define OFFSET_TEXELS 1.5  // normal offset of a shadow test, in shadow texels
+// The slope-scaled part of a light's test's offset is capped at tan θ = MAX_SLOPE: more moved shadows' edges (up to
+// 17 texels off the surface at 8: a sofa lit by the sun through the wall 2 cm beside a window's edge), less lets
+// surfaces at grazing angles shadow themselves (a textured floor's speckles at 0).
+#define MAX_SLOPE 1.0
 uniform sampler2DShadow u_shadow_atlas;
 uniform sampler2D u_shadow_depth;  // the same atlas's depths, read without comparison (gl/bind.RAW_DEPTH_UNIT)
 uniform vec2 u_atlas_texel;        // 1 / atlas size
@@ -15,13 +19,16 @@ uniform vec2 u_atlas_texel;        // 1 / atlas size
 // voxels' injection.
 uniform int u_sky_stride;
 
-// The point a shadow test of view v projects for p: p pushed off its surface along its geometric normal by
-// OFFSET_TEXELS of the view's texels there, clear of the depth the rasteriser stored for p's own surface. The texels
-// beside it are compared with the receiver's plane through that point (receiver_slope), so no larger offset is
-// needed at grazing angles — a slope-scaled offset (up to 17 texels) moved shadows' edges.
-vec3 biased_point(ShadowView v, vec3 p, vec3 geo_n) {
-    float dist = v.origin.w > 0.5 ? 1.0 : length(p - v.origin.xyz);
-    return p + geo_n * (v.info.x * dist * OFFSET_TEXELS);
+// Visibility of world point p from one shadow view with a normal-offset bias and percentage-closer filtering.
+// The offset grows with the shadow texel's world footprint, which removes acne without a hand-tuned constant.
+vec3 biased_point(ShadowView v, vec3 p, vec3 geo_n, vec3 to_light, float max_slope) {
+    bool ortho = v.origin.w > 0.5;
+    float dist = ortho ? 1.0 : length(p - v.origin.xyz);
+    float texel_world = v.info.x * dist;
+    float cos_l = clamp(dot(geo_n, to_light), 0.0, 1.0);
+    float sin_l = sqrt(max(0.0, 1.0 - cos_l * cos_l));
+    // 1.5 texels along the normal, more at grazing angles (slope-scaled), capped.
+    return p + geo_n * texel_world * (OFFSET_TEXELS + 2.0 * min(sin_l / max(cos_l, 0.05), max_slope));
 }
 
 // Where the test of view `view_index` at p reads: the atlas uv of p biased (biased_point) and its depth as the
@@ -40,17 +47,17 @@ bool view_project(ShadowView v, vec3 x, out vec2 atlas_uv, out float depth) {
     return true;
 }
 
-bool view_uv_depth_biased(ShadowView v, vec3 p, vec3 geo_n, out vec2 atlas_uv, out float depth) {
-    if (!view_project(v, biased_point(v, p, geo_n), atlas_uv, depth)) return false;
+bool view_uv_depth_biased(ShadowView v, vec3 p, vec3 geo_n, vec3 to_light, float max_slope, out vec2 atlas_uv,
+                          out float depth) {
+    if (!view_project(v, biased_point(v, p, geo_n, to_light, max_slope), atlas_uv, depth)) return false;
     vec2 uv = (atlas_uv - v.tile.xy) / v.tile.zw;
     return all(greaterThanEqual(uv, vec2(0.0))) && all(lessThanEqual(uv, vec2(1.0)));  // outside: unshadowed
 }
 
-// How the stored depth of the plane through q (normal geo_n) changes per atlas uv around q's own: a PCF tap beside
-// q is compared with that plane there, not with q's depth, so a surface seen at a grazing angle does not shadow
-// itself across the kernel and needs no large offset off it (which moved shadows' edges: a sunlit sofa lit through
-// a wall 2 cm beside a window's edge). Receiver plane depth bias: Isidoro 2006, "Shadow mapping: GPU-based tips and
-// techniques". Zero where the plane holds the view's rays (it covers no texel).
+// How the stored depth of the plane through q (normal geo_n) changes per atlas uv around q's own: a tap of a wide
+// region beside q is compared with that plane there, not with q's depth, so the receiver does not shadow itself
+// across the region (receiver plane depth bias: Isidoro 2006, "Shadow mapping: GPU-based tips and techniques").
+// Zero where the plane holds the view's rays (it covers no texel).
 vec2 receiver_slope(ShadowView v, vec3 q, vec3 geo_n, vec2 atlas_uv, float depth) {
     float size = v.info.x * (v.origin.w > 0.5 ? 1.0 : length(q - v.origin.xyz));   // a texel's world size at q
     vec3 t1 = normalize(cross(geo_n, abs(geo_n.z) < 0.9 ? vec3(0.0, 0.0, 1.0) : vec3(1.0, 0.0, 0.0)));
@@ -77,15 +84,17 @@ float gather_gap(ShadowView v, vec2 atlas_uv, float depth) {
     return depth - min(min(z.x, z.y), min(z.z, z.w));
 }
 
-// Visibility of p from shadow view `view_index`: percentage-closer filtering over its PCF radius, or the sky's
-// four-texel test (radius 0). `gap`: with PCF radius 0, how far (in stored depth) the nearest of the four texels
-// read lies in front of p (≤ 0: none does); 0 otherwise.
-float view_test(int view_index, vec3 p, vec3 geo_n, out float gap) {
+// max_slope caps the slope-scaled part of the offset (MAX_SLOPE for a light's own maps; 0 for the sky's many directions: a
+// grazing one pushed far off the surface would test a point beyond a thin wall, and acne in a few of them is
+// averaged away).
+// `gap`: with PCF radius 0, how far (in stored depth) the nearest of the four texels read lies in front of p (≤ 0:
+// none does); 0 otherwise.
+float view_test(int view_index, vec3 p, vec3 geo_n, vec3 to_light, float max_slope, out float gap) {
     gap = 0.0;
     ShadowView v = shadow_views[view_index];
     vec2 atlas_uv;
     float depth;
-    if (!view_uv_depth_biased(v, p, geo_n, atlas_uv, depth)) return 1.0;
+    if (!view_uv_depth_biased(v, p, geo_n, to_light, max_slope, atlas_uv, depth)) return 1.0;
     vec2 lo = v.tile.xy + 0.5 * u_atlas_texel;
     vec2 hi = v.tile.xy + v.tile.zw - 0.5 * u_atlas_texel;
     // PCF: a (2r+1)² grid of bilinear hardware comparisons.
@@ -99,23 +108,22 @@ float view_test(int view_index, vec3 p, vec3 geo_n, out float gap) {
         gap = gather_gap(v, atlas_uv, depth);
         return gap <= 0.0 ? 1.0 : 0.0;
     }
-#if defined(POINT_RECEIVERS)
-    vec2 slope = vec2(0.0);   // p is on no surface (a voxel face's centre): no plane to compare the taps with
-#else
-    vec2 slope = receiver_slope(v, biased_point(v, p, geo_n), geo_n, atlas_uv, depth);
-#endif
     float sum = 0.0;
     for (int j = -r; j <= r; ++j)
         for (int i = -r; i <= r; ++i) {
             vec2 s = clamp(atlas_uv + vec2(i, j) * u_atlas_texel, lo, hi);
-            sum += texture(u_shadow_atlas, vec3(s, depth + dot(slope, s - atlas_uv)));
+            sum += texture(u_shadow_atlas, vec3(s, depth));
         }
     return sum / float((2 * r + 1) * (2 * r + 1));
 }
 
-float view_visibility(int view_index, vec3 p, vec3 geo_n) {
+float view_visibility_biased(int view_index, vec3 p, vec3 geo_n, vec3 to_light, float max_slope) {
     float gap;
-    return view_test(view_index, p, geo_n, gap);
+    return view_test(view_index, p, geo_n, to_light, max_slope, gap);
+}
+
+float view_visibility(int view_index, vec3 p, vec3 geo_n, vec3 to_light) {
+    return view_visibility_biased(view_index, p, geo_n, to_light, MAX_SLOPE);
 }
 
 // The face is chosen for the biased point, the one the test projects: chosen for p, a point near a face's edge
@@ -124,8 +132,9 @@ float view_visibility(int view_index, vec3 p, vec3 geo_n) {
 // view's texel size, so the bias is the same whichever face is asked.
 float cube_visibility(int first_view, vec3 p, vec3 geo_n) {
     vec3 origin = shadow_views[first_view].origin.xyz;
-    vec3 q = biased_point(shadow_views[first_view], p, geo_n);
-    return view_visibility(first_view + cube_face(q - origin), p, geo_n);
+    vec3 to_light = normalize(origin - p);
+    vec3 q = biased_point(shadow_views[first_view], p, geo_n, to_light, MAX_SLOPE);
+    return view_visibility(first_view + cube_face(q - origin), p, geo_n, to_light);
 }
 
 #define PATCH_GATHERS 8            // at most, per axis: 2×2 texels each, over the region a blocker can shadow
@@ -155,9 +164,9 @@ vec2 patch_overlap(vec2 c, vec2 w, float h) {
 // of the receiver's plane at that texel (Isidoro 2006, "Shadow mapping: GPU-based tips and techniques": receiver-
 // plane depth bias), so the receiver does not shadow itself across the region. A patch too small for its penumbra to
 // span two texels keeps the light's usual PCF.
-float patch_visibility(int view_index, vec3 p, vec3 geo_n, float h) {
+float patch_visibility(int view_index, vec3 p, vec3 geo_n, vec3 to_light, float h) {
     ShadowView v = shadow_views[view_index];
-    vec3 q = biased_point(v, p, geo_n);
+    vec3 q = biased_point(v, p, geo_n, to_light, MAX_SLOPE);
     vec4 clip = v.view_projection * vec4(q, 1.0);
     if (clip.w <= 0.0) return 1.0;
     vec2 uv = clip.xy / clip.w * 0.5 + 0.5;
@@ -166,7 +175,7 @@ float patch_visibility(int view_index, vec3 p, vec3 geo_n, float h) {
     float tau = v.info.x;                      // a texel's angle (texel world size at unit distance)
     // Blockers at a fifth of the distance or farther: 1/z − 1/d_r ≤ 4/d_r.
     float search = min(4.0 * h / (d_r * tau), MAX_SEARCH_SHARE * v.tile.z / u_atlas_texel.x);
-    if (search < 2.0) return view_visibility(view_index, p, geo_n);
+    if (search < 2.0) return view_visibility_biased(view_index, p, geo_n, to_light, MAX_SLOPE);
     vec3 c0 = view_uv_depth(v, q);
     vec2 grad = receiver_slope(v, q, geo_n, c0.xy, c0.z);   // the receiver plane's depth per atlas uv
     // Gathers read the 2 × 2 texels around their point: points within [lo, hi] keep them inside the tile.
@@ -183,7 +192,7 @@ float patch_visibility(int view_index, vec3 p, vec3 geo_n, float h) {
         for (int i = 0; i < 4; ++i)
             if (z[i] < ref) nearest = min(nearest, z[i]);
     }
-    if (nearest > 1.0) return view_visibility(view_index, p, geo_n);
+    if (nearest > 1.0) return view_visibility_biased(view_index, p, geo_n, to_light, MAX_SLOPE);
     float reach = h * (1.0 / max(nearest * v.info.z, 1e-6 * d_r) - 1.0 / d_r) / tau + 1.0;
     float region = clamp(reach, 2.0, search);
     // Gathers spaced `spacing` texels apart: each of their texels stands for the block of spacing/2 texels on its
@@ -217,8 +226,9 @@ float patch_visibility(int view_index, vec3 p, vec3 geo_n, float h) {
 // cube_visibility for a polygon light's sample point standing for a patch of half-size h (patch_visibility).
 float cube_patch_visibility(int first_view, vec3 p, vec3 geo_n, float h) {
     vec3 origin = shadow_views[first_view].origin.xyz;
-    vec3 q = biased_point(shadow_views[first_view], p, geo_n);
-    return patch_visibility(first_view + cube_face(q - origin), p, geo_n, h);
+    vec3 to_light = normalize(origin - p);
+    vec3 q = biased_point(shadow_views[first_view], p, geo_n, to_light, MAX_SLOPE);
+    return patch_visibility(first_view + cube_face(q - origin), p, geo_n, to_light, h);
 }
 
 // Weighted visibility of a polygon light from its shadow sample points: each sample k stands for a share A_k of the
@@ -298,7 +308,7 @@ float sky_visibility(GpuLight L, vec3 p, vec3 n, vec3 geo_n) {
         float w = max(dot(n, d), 0.0);
         if (w <= 1e-4) continue;
         wsum += w;
-        vsum += w * view_visibility(int(L.params.y) + k, p, geo_n);
+        vsum += w * view_visibility_biased(int(L.params.y) + k, p, geo_n, d, 0.0);
     }
     return wsum > 0.0 ? vsum / wsum : 0.0;
 }
@@ -346,9 +356,9 @@ vec3 light_unshadowed_sides(GpuLight L, vec3 p, vec3 n, out vec3 back) {
 float light_visibility(GpuLight L, vec3 p, vec3 n, vec3 geo_n) {
     if (L.params.z <= 0.0) return 1.0;
     int type = int(L.color_type.w);
-    if (type == LIGHT_SUN) return view_visibility(int(L.params.y), p, geo_n);
+    if (type == LIGHT_SUN) return view_visibility(int(L.params.y), p, geo_n, -L.direction.xyz);
     if (type == LIGHT_POINT) return cube_visibility(int(L.params.y), p, geo_n);
-    if (type == LIGHT_SPOT) return view_visibility(int(L.params.y), p, geo_n);
+    if (type == LIGHT_SPOT) return view_visibility(int(L.params.y), p, geo_n, normalize(L.position.xyz - p));
     if (type == LIGHT_SKY) return sky_visibility(L, p, n, geo_n);
     return polygon_visibility(L, p, n, geo_n);
 }

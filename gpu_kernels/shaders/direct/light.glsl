@@ -88,7 +88,10 @@ bool unchanged(ivec2 px, vec3 p, vec3 geo_n) {
         ShadowView v0 = shadow_views[f];
         if (f != first) {
             first = f;
-            q = biased_point(v0, p, geo_n);
+            int type = int(L.color_type.w);
+            vec3 to_light = v0.origin.w > 0.5 ? -L.direction.xyz
+                          : normalize((type == LIGHT_SPOT ? L.position.xyz : v0.origin.xyz) - p);
+            q = biased_point(v0, p, geo_n, to_light, MAX_SLOPE);
             face = cube ? f + cube_face(q - v0.origin.xyz) : f;
         }
         if (c.index.x == face && reads_changed(c, L, v0, q, p)) return false;

@@ -90,8 +90,8 @@ vec4 sky_cone_taps(int view, vec3 p, vec3 n, vec3 geo_n, vec3 d, float g, int k,
     vec2 uv0;
     float depth;
     vec4 sum = vec4(0.0);
-    if (!view_uv_depth_biased(sv, p, geo_n, uv0, depth)) return sum;
-    vec3 q = biased_point(sv, p, geo_n);
+    if (!view_uv_depth_biased(sv, p, geo_n, d, 0.0, uv0, depth)) return sum;
+    vec3 q = biased_point(sv, p, geo_n, d, 0.0);
     vec2 slope = receiver_slope(sv, q, geo_n, uv0, depth);
     float beyond = depth - SKY_SLAB * g / ortho_depth_scale(view);
     float radius = g * tan(cell);
@@ -117,7 +117,7 @@ vec4 sky_cone_taps(int view, vec3 p, vec3 n, vec3 geo_n, vec3 d, float g, int k,
 // How far (m) in front of p the nearest texel of direction view's test lies; 0 where none does.
 float sky_gap(int view, vec3 p, vec3 geo_n) {
     float gap;
-    view_test(view, p, geo_n, gap);
+    view_test(view, p, geo_n, shadow_views[view].emitter.xyz, 0.0, gap);
     return max(gap, 0.0) * ortho_depth_scale(view);
 }
 
@@ -170,7 +170,7 @@ SkySums sky_sums(GpuLight L, vec3 p, vec3 n, vec3 geo_n, GlossyLobe lobe, vec3 v
         if (counted) {
             s.weights.xy += w;
             float gap;
-            seen = view_test(first + k, p, geo_n, gap);
+            seen = view_test(first + k, p, geo_n, d, 0.0, gap);
             s.weights.zw += w * seen;
             if (gap > 0.0 && w.x > 0.0) s.penumbra += vec2(w.x / (gap * ortho_depth_scale(first + k)), w.x);
         }
@@ -230,7 +230,7 @@ bool sky_reads_redrawn(GpuLight L, vec3 p, vec3 geo_n) {
         ShadowView sv = shadow_views[view];
         vec2 atlas_uv;
         float depth;
-        if (!view_uv_depth_biased(sv, p, geo_n, atlas_uv, depth)) continue;
+        if (!view_uv_depth_biased(sv, p, geo_n, sv.emitter.xyz, 0.0, atlas_uv, depth)) continue;
         vec2 t = gather_point(sv, atlas_uv) / u_atlas_texel - 0.5;
         float reach = sky_reach(view, samples) + 1.0;
         ivec4 r = sky_redrawn[k];

@@ -26,9 +26,6 @@ layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;  // gl/bind.VOL
 #endif
 uniform ivec3 u_grid_size;
 
-#if defined(MODE_FALLBACK)
-#define POINT_RECEIVERS   // a face's centre lies on no surface: its shadow tests have no plane (direct/eval.glsl)
-#endif
 #if defined(MODE_RESOLVE) || defined(MODE_FALLBACK)
 #include "common/lights.glsl"
 #include "common/light_eval.glsl"
