@@ -264,8 +264,8 @@ def render_depth(ctx, programs, geometry: GeometryBuffers, views: list, tiles: l
     maps (the pass cache, whose entry it then is) — the tiles whose view changed (a light's move redraws that light's
     maps), and where the scene's triangles (`positions`) moved since `prior` was drawn, in every other tile the
     rectangle the moved triangles' box covers (moved_rects). `rows`: view_rows(views). The depths the rectangles
-    overwrite are kept, and which of them changed found (DepthAtlas.overwritten, changed_views): the sky's tests are
-    taken out and added back from them (direct/sky.py), and what reads none of the changed texels keeps its light."""
+    overwrite are kept, and which of them changed found (DepthAtlas.overwritten, changed_views): what reads none of
+    the changed texels keeps its light (direct/lighting.Relight) and its sky shares (direct/sky.py)."""
     import moderngl
 
     rows = view_rows(views) if rows is None else rows

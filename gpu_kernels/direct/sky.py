@@ -7,6 +7,7 @@ the pixels whose tests can read a texel it redrew are made anew (SkyUpdate)."""
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -17,14 +18,14 @@ from .lighting import bind_inputs
 from .shadows import ShadowAtlas
 
 TILE = 8  # pixels per side of a work group of direct/light.glsl: the blocks an update lists directions for
-NEIGHBOURS = 6  # per sky direction, its nearest (direct/sky.glsl SKY_NEIGHBOURS)
+NEAREST = 6  # per sky direction, its nearest others (and those that have it among theirs: neighbours)
 
 
 @dataclass
 class SkyShares:
     """`texture`: RGBA32F, per pixel the shares of the sky's cosine weight (x) and of the glossy lobe's (y) that its
     directions' tests find visible, and the penumbra's half-width (z, m), the diffuse share filtered; `raw`: the
-    same unfiltered, which an object's move updates; `made_from`: the depth atlas (serial, generation), the scene's
+    same unfiltered, which an object's move keeps where it cannot change them; `made_from`: the depth atlas (serial, generation), the scene's
     triangles and the G-buffer's key they were made with."""
     texture: object
     raw: object
@@ -63,12 +64,14 @@ def render_sky_visibility(ctx, programs, gbuffer: GBuffer, shadows: ShadowAtlas,
         return None
     w, h = gbuffer.size
     raw = ctx.texture((w, h), 4, dtype="f4")
-    prog = programs.compute("direct/light.glsl", {"MODE_SKY": None, **shadows.defines})
+    first, count = (int(v) for v in shadows.buffers.lights[sky]["params"][1:3])
+    table = neighbours(np.array([v.emit_normal for v in shadows.buffers.views[first:first + count]]).tobytes())
+    prog = programs.compute("direct/light.glsl", {"MODE_SKY": None, "SKY_NEIGHBOURS": table.shape[1],
+                                                  **shadows.defines})
     raw.bind_to_image(2, read=False, write=True)
     unit = bind_inputs(prog, gbuffer, shadows, material_lut)
     set_uniforms(prog, {"u_sky_update": update is not None,
                         "u_moved_pixels": tuple(update.pixels) if update else (0, 0, 0, 0)})
-    first, count = (int(v) for v in shadows.buffers.lights[sky]["params"][1:3])
     buffers = []
     if update is not None:
         bind_samplers(prog, "u_sky_prior", [update.prior.raw], unit)
@@ -78,7 +81,7 @@ def render_sky_visibility(ctx, programs, gbuffer: GBuffer, shadows: ShadowAtlas,
         bind_light_records(shadows)
         buffers[1].bind_to_storage_buffer(13)
         set_uniforms(prog, {"u_tiles_x": -(-w // TILE), "u_sky_words": -(-len(update.table) // 32)})
-    buffers.append(ssbo(ctx, neighbours(shadows.buffers.views[first:first + count])))
+    buffers.append(ssbo(ctx, table))
     buffers[-1].bind_to_storage_buffer(14)  # after tile_directions, whose output binds there
     dispatch(prog, (w, h), local=TILE)
     for buffer in buffers:
@@ -86,13 +89,22 @@ def render_sky_visibility(ctx, programs, gbuffer: GBuffer, shadows: ShadowAtlas,
     return SkyShares(filter_sky_shares(ctx, programs, gbuffer, raw), raw)
 
 
-def neighbours(views: list) -> np.ndarray:
-    """(K, NEIGHBOURS) int32: per sky direction (its view's emit_normal), the indices of its nearest others."""
-    dirs = np.array([v.emit_normal for v in views], np.float64).reshape(-1, 3)
-    if len(dirs) <= NEIGHBOURS:
-        return np.zeros((len(dirs), NEIGHBOURS), np.int32)
-    near = np.argpartition(-(dirs @ dirs.T), NEIGHBOURS, axis=1)[:, :NEIGHBOURS + 1]
-    return np.array([[j for j in row if j != i][:NEIGHBOURS] for i, row in enumerate(near)], np.int32)
+@lru_cache(maxsize=4)
+def neighbours(directions: bytes) -> np.ndarray:
+    """(K, N) int32: per sky direction (the float64 unit vectors' bytes, K × 3), its NEAREST nearest others and
+    every direction that has it among its own nearest, padded with its own index: the relation made mutual, so that
+    the edge cells direct/sky.glsl marks from the seen side and from the blocked side are the same."""
+    dirs = np.frombuffer(directions, np.float64).reshape(-1, 3)
+    k = min(NEAREST, len(dirs) - 1)
+    if k < 1:
+        return np.zeros((len(dirs), 1), np.int32)
+    near = np.argsort(-(dirs @ dirs.T), axis=1)[:, 1:k + 1]
+    sets = [set(row) for row in near.tolist()]
+    for i, row in enumerate(near.tolist()):
+        for j in row:
+            sets[j].add(i)
+    width = max(len(s) for s in sets)
+    return np.array([sorted(s) + [i] * (width - len(s)) for i, s in enumerate(sets)], np.int32)
 
 
 def tile_boxes(gbuffer: GBuffer, moved: tuple) -> np.ndarray:
@@ -116,8 +128,8 @@ def tile_boxes(gbuffer: GBuffer, moved: tuple) -> np.ndarray:
 
 
 def tile_directions(ctx, programs, gbuffer: GBuffer, shadows: ShadowAtlas, update: SkyUpdate):
-    """Per TILE × TILE block, one bit per sky direction whose redrawn rectangle a test at one of the block's
-    updated points can read (direct/sky_tiles.glsl): a buffer the update reads (direct/sky.glsl SkyTiles)."""
+    """Per TILE × TILE block, one bit per sky direction whose changed box a test at one of the block's points
+    that may be kept can read (direct/sky_tiles.glsl): a buffer the update reads (direct/sky.glsl SkyTiles)."""
     w, h = gbuffer.size
     boxes = ssbo(ctx, tile_boxes(gbuffer, update.pixels))
     tiles, words = (-(-w // TILE)) * (-(-h // TILE)), -(-len(update.table) // 32)

@@ -4,7 +4,10 @@ each direction, the edge cells' cones up to direct/eval.glsl sky_reach beyond th
 redrew, or that the moved object can cover, is made anew; every other keeps its shares of one update ago. Against
 a cold render of the moved scene: the same Diffuse and Glossy Direct to float32 rounding (1e-5 of the image's
 mean: a pixel kept that should have been made anew is off by a whole direction's share, 1/64 here)."""
+from dataclasses import replace
+
 import numpy as np
+import pytest
 
 from bounce_gi.gpu_kernels.common.lights import ShadowSettings
 from bounce_gi.gpu_kernels.direct import sky
@@ -27,7 +30,9 @@ def _yard(x):
                       eye=(1.0, -7.0, 5.0), target=(0.0, 0.5, 0.5), world=(0.4, 0.5, 0.7))
 
 
-def test_an_object_move_updates_the_skys_visibility_to_what_a_cold_render_gives(engines, monkeypatch):
+@pytest.mark.parametrize("directions", (64, 50, 800), ids=("64 directions", "50: a last word of bits part-filled",
+                                                             "800: more than the cones' bits hold, hard tests"))
+def test_an_object_move_updates_the_skys_visibility_to_what_a_cold_render_gives(engines, monkeypatch, directions):
     warm, cold = engines
     updates, shares, tile_directions = [], [], sky.tile_directions
 
@@ -38,10 +43,11 @@ def test_an_object_move_updates_the_skys_visibility_to_what_a_cold_render_gives(
         updates.append(update)
         return out
     monkeypatch.setattr(sky, "tile_directions", counted)
-    warm.render(_yard(0.0), SETTINGS)
+    settings = replace(SETTINGS, shadow=replace(SETTINGS.shadow, sky_directions=directions))
+    warm.render(_yard(0.0), settings)
     for x in (0.3, 0.6):
-        result = warm.render(_yard(x), SETTINGS)
-        fresh = cold.render(_yard(x), SETTINGS)
+        result = warm.render(_yard(x), settings)
+        fresh = cold.render(_yard(x), settings)
         cold.clear_cache()
         for name in ("Diffuse Direct", "Glossy Direct", "Combined"):
             a, b = result.passes[name], fresh.passes[name]

@@ -31,9 +31,6 @@ vec3 biased_point(ShadowView v, vec3 p, vec3 geo_n, vec3 to_light, float max_slo
     return p + geo_n * texel_world * (OFFSET_TEXELS + 2.0 * min(sin_l / max(cos_l, 0.05), max_slope));
 }
 
-// Where the test of view `view_index` at p reads: the atlas uv of p biased (biased_point) and its depth as the
-// shadow pass stored it — rasterised z (ortho) or radial distance / far (perspective); false where p lies behind the
-// view's eye or outside its map (unshadowed).
 // Atlas uv and stored depth of world point x in view v (rasterised z for an orthographic view, radial distance /
 // far for a perspective one); false where x lies behind the view's eye.
 bool view_project(ShadowView v, vec3 x, out vec2 atlas_uv, out float depth) {
@@ -47,6 +44,8 @@ bool view_project(ShadowView v, vec3 x, out vec2 atlas_uv, out float depth) {
     return true;
 }
 
+// Where the test of view `view_index` at p reads: the atlas uv of p biased (biased_point) and its depth as the
+// shadow pass stored it; false where p lies behind the view's eye or outside its map (unshadowed).
 bool view_uv_depth_biased(ShadowView v, vec3 p, vec3 geo_n, vec3 to_light, float max_slope, out vec2 atlas_uv,
                           out float depth) {
     if (!view_project(v, biased_point(v, p, geo_n, to_light, max_slope), atlas_uv, depth)) return false;
@@ -140,13 +139,6 @@ float cube_visibility(int first_view, vec3 p, vec3 geo_n) {
 #define PATCH_GATHERS 8            // at most, per axis: 2×2 texels each, over the region a blocker can shadow
 #define MAX_SEARCH_SHARE 0.25      // that region's half-width cap, as a share of the map's side (64 of 256 texels)
 
-// Atlas uv and stored depth (distance / far) of world point x in perspective view v.
-vec3 view_uv_depth(ShadowView v, vec3 x) {
-    vec4 clip = v.view_projection * vec4(x, 1.0);
-    vec2 uv = clip.xy / clip.w * 0.5 + 0.5;
-    return vec3(v.tile.xy + uv * v.tile.zw, length(x - v.origin.xyz) / v.info.z);
-}
-
 // The share of [−h, h] that [c − w, c + w] covers, per axis.
 vec2 patch_overlap(vec2 c, vec2 w, float h) {
     return max(min(vec2(h), c + w) - max(vec2(-h), c - w), vec2(0.0)) / (2.0 * h);
@@ -176,7 +168,8 @@ float patch_visibility(int view_index, vec3 p, vec3 geo_n, vec3 to_light, float 
     // Blockers at a fifth of the distance or farther: 1/z − 1/d_r ≤ 4/d_r.
     float search = min(4.0 * h / (d_r * tau), MAX_SEARCH_SHARE * v.tile.z / u_atlas_texel.x);
     if (search < 2.0) return view_visibility_biased(view_index, p, geo_n, to_light, MAX_SLOPE);
-    vec3 c0 = view_uv_depth(v, q);
+    vec3 c0;
+    view_project(v, q, c0.xy, c0.z);
     vec2 grad = receiver_slope(v, q, geo_n, c0.xy, c0.z);   // the receiver plane's depth per atlas uv
     // Gathers read the 2 × 2 texels around their point: points within [lo, hi] keep them inside the tile.
     vec2 lo = v.tile.xy + 0.5 * u_atlas_texel;

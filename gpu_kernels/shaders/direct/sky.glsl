@@ -39,7 +39,7 @@ float sky_lobe_a2(GlossyLobe lobe, int samples) {
 // The cells an edge crosses. A hard test per direction makes the share step by a whole cell's weight wherever an
 // opening's edge passes a direction: through a window a few directions of the hundreds reach the sky, so a room's
 // walls showed ±10–20% blotches that no filter over the image removed without blurring the light's real gradients.
-// Where a counted direction and one of its SKY_NEIGHBOURS nearest differ (seen / blocked), its cell is tested over
+// Where a counted direction and one of its neighbours differ (seen / blocked), its cell is tested over
 // its cone instead: SKY_TAPS rays spread over a disc of the cell's radius at the blockers' distance g, each read
 // from the direction's own map (the cone's ray at distance g from p crosses the map there) and weighted by its own
 // direction — as percentage-closer soft shadows size a filter by the blocker's distance (Fernando 2005,
@@ -47,10 +47,12 @@ float sky_lobe_a2(GlossyLobe lobe, int samples) {
 // only beyond the nearest SKY_SLAB of g and in front of the receiver's own plane (which never shadows itself).
 // SKY_WORDS words of bits per pixel: a sky of more directions keeps hard tests.
 #define SKY_WORDS 24
-#define SKY_NEIGHBOURS 6
 #define SKY_TAPS 12
 #define SKY_SLAB 0.25
 #define GOLDEN_ANGLE 2.39996323
+// Per direction its nearest six and every direction that has it among its nearest six, SKY_NEIGHBOURS in all
+// (direct/sky.py neighbours: the relation made mutual, so the edge cells are the same whichever side marks them;
+// padded with the direction itself).
 layout(std430, binding = 14) readonly buffer SkyNeighbours { int sky_neighbours[]; };  // K × SKY_NEIGHBOURS
 
 // Per direction, one bit each: counted, seen, and on an edge (this invocation's own: globals, not arguments, so
@@ -83,15 +85,17 @@ void sky_mark_edges(int samples, bool from_seen) {
     }
 }
 
-// Cell k's cone at p: (Σ w, Σ w · seen) / SKY_TAPS over its taps (a tap below the horizon counts for nothing).
-vec4 sky_cone_taps(int view, vec3 p, vec3 n, vec3 geo_n, vec3 d, float g, int k, GlossyLobe lobe,
-                   GlossyFresnel fresnel, float a2, vec3 v, bool lobe_seen, float cell) {
+// Cell k's cone at p: (Σ w, Σ w · seen) / SKY_TAPS over its taps (a tap below the horizon counts for nothing);
+// false where p's own point lies outside the direction's map (its hard test stands).
+bool sky_cone_taps(int view, vec3 p, vec3 n, vec3 geo_n, vec3 d, float g, int k, GlossyLobe lobe,
+                   GlossyFresnel fresnel, float a2, vec3 v, bool lobe_seen, float cell, out vec4 sum) {
     ShadowView sv = shadow_views[view];
+    vec3 q = biased_point(sv, p, geo_n, d, 0.0);
     vec2 uv0;
     float depth;
-    vec4 sum = vec4(0.0);
-    if (!view_uv_depth_biased(sv, p, geo_n, d, 0.0, uv0, depth)) return sum;
-    vec3 q = biased_point(sv, p, geo_n, d, 0.0);
+    sum = vec4(0.0);
+    if (!view_project(sv, q, uv0, depth) || any(lessThan(uv0, sv.tile.xy))
+        || any(greaterThan(uv0, sv.tile.xy + sv.tile.zw))) return false;
     vec2 slope = receiver_slope(sv, q, geo_n, uv0, depth);
     float beyond = depth - SKY_SLAB * g / ortho_depth_scale(view);
     float radius = g * tan(cell);
@@ -111,7 +115,8 @@ vec4 sky_cone_taps(int view, vec3 p, vec3 n, vec3 geo_n, vec3 d, float g, int k,
             seen = texture(u_shadow_atlas, vec3(clamp(uv, lo, hi), min(beyond, depth + dot(slope, uv - uv0))));
         sum += vec4(w, w * seen);
     }
-    return sum / float(SKY_TAPS);
+    sum /= float(SKY_TAPS);
+    return true;
 }
 
 // How far (m) in front of p the nearest texel of direction view's test lies; 0 where none does.
@@ -145,24 +150,24 @@ void sky_soften(inout SkySums s, GpuLight L, vec3 p, vec3 n, vec3 geo_n, GlossyL
             vec3 d;
             vec2 w;
             sky_weights(L, k, n, geo_n, lobe, fresnel, a2, v, lobe_seen, d, w);
-            vec4 taps = sky_cone_taps(first + k, p, n, geo_n, d, g, k, lobe, fresnel, a2, v, lobe_seen, cell);
-            s.weights += taps - vec4(w, pass == 1 ? w : vec2(0.0));
+            vec4 taps;
+            if (sky_cone_taps(first + k, p, n, geo_n, d, g, k, lobe, fresnel, a2, v, lobe_seen, cell, taps))
+                s.weights += taps - vec4(w, pass == 1 ? w : vec2(0.0));
         }
 }
 #endif
 
-// The sums of every counted direction's test (every u_sky_stride-th: the voxels' injection reads a few), and for a
-// pixel (MODE_SKY) the edge cells' cones.
+// The sums of every counted direction's test, and for a pixel (MODE_SKY) the edge cells' cones.
 SkySums sky_sums(GpuLight L, vec3 p, vec3 n, vec3 geo_n, GlossyLobe lobe, vec3 v, bool lobe_seen) {
     SkySums s = SkySums(vec4(0.0), vec2(0.0));
-    int samples = int(L.params.z), first = int(L.params.y), stride = max(u_sky_stride, 1);
+    int samples = int(L.params.z), first = int(L.params.y);
     float a2 = sky_lobe_a2(lobe, max(samples, 1));
     GlossyFresnel fresnel = glossy_fresnel_rows(u_material_lut, lobe.material, lobe.mu, lobe.base);
 #if defined(MODE_SKY)
     int counted_count = 0, seen_count = 0;
     uint counted_word = 0u, seen_word = 0u;   // stored whole every 32 directions
 #endif
-    for (int k = 0; k < samples; k += stride) {
+    for (int k = 0; k < samples; ++k) {
         vec3 d;
         vec2 w;
         bool counted = sky_weights(L, k, n, geo_n, lobe, fresnel, a2, v, lobe_seen, d, w);
@@ -184,7 +189,7 @@ SkySums sky_sums(GpuLight L, vec3 p, vec3 n, vec3 geo_n, GlossyLobe lobe, vec3 v
             seen_word |= bit;
             seen_count += 1;
         }
-        if (((k & 31) == 31 || k + stride >= samples) && k < 32 * SKY_WORDS) {
+        if (((k & 31) == 31 || k + 1 == samples) && k < 32 * SKY_WORDS) {
             sky_counted[k >> 5] = counted_word;
             sky_seen[k >> 5] = seen_word;
             counted_word = seen_word = 0u;
@@ -192,7 +197,7 @@ SkySums sky_sums(GpuLight L, vec3 p, vec3 n, vec3 geo_n, GlossyLobe lobe, vec3 v
 #endif
     }
 #if defined(MODE_SKY)
-    if (stride == 1 && samples <= 32 * SKY_WORDS)
+    if (samples <= 32 * SKY_WORDS)
         sky_soften(s, L, p, n, geo_n, lobe, fresnel, a2, v, lobe_seen, 2 * seen_count < counted_count);
 #endif
     return s;
