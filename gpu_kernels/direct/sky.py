@@ -25,8 +25,8 @@ NEAREST = 6  # per sky direction, its nearest others (and those that have it amo
 class SkyShares:
     """`texture`: RGBA32F, per pixel the shares of the sky's cosine weight (x) and of the glossy lobe's (y) that its
     directions' tests find visible, and the penumbra's half-width (z, m), the diffuse share filtered; `raw`: the
-    same unfiltered, which an object's move keeps where it cannot change them; `made_from`: the depth atlas (serial, generation), the scene's
-    triangles and the G-buffer's key they were made with."""
+    same unfiltered, which an object's move keeps where it cannot change them; `made_from`: the depth atlas
+    (serial, generation), the scene's triangles and the G-buffer's key they were made with."""
     texture: object
     raw: object
     made_from: tuple = None

@@ -44,13 +44,16 @@ bool view_project(ShadowView v, vec3 x, out vec2 atlas_uv, out float depth) {
     return true;
 }
 
+// Whether atlas uv lies in view v's tile (outside it: nothing the map holds blocks the point).
+bool in_tile(ShadowView v, vec2 atlas_uv) {
+    return all(greaterThanEqual(atlas_uv, v.tile.xy)) && all(lessThanEqual(atlas_uv, v.tile.xy + v.tile.zw));
+}
+
 // Where the test of view `view_index` at p reads: the atlas uv of p biased (biased_point) and its depth as the
 // shadow pass stored it; false where p lies behind the view's eye or outside its map (unshadowed).
 bool view_uv_depth_biased(ShadowView v, vec3 p, vec3 geo_n, vec3 to_light, float max_slope, out vec2 atlas_uv,
                           out float depth) {
-    if (!view_project(v, biased_point(v, p, geo_n, to_light, max_slope), atlas_uv, depth)) return false;
-    vec2 uv = (atlas_uv - v.tile.xy) / v.tile.zw;
-    return all(greaterThanEqual(uv, vec2(0.0))) && all(lessThanEqual(uv, vec2(1.0)));  // outside: unshadowed
+    return view_project(v, biased_point(v, p, geo_n, to_light, max_slope), atlas_uv, depth) && in_tile(v, atlas_uv);
 }
 
 // How the stored depth of the plane through q (normal geo_n) changes per atlas uv around q's own: a tap of a wide

@@ -94,8 +94,7 @@ bool sky_cone_taps(int view, vec3 p, vec3 n, vec3 geo_n, vec3 d, float g, int k,
     vec2 uv0;
     float depth;
     sum = vec4(0.0);
-    if (!view_project(sv, q, uv0, depth) || any(lessThan(uv0, sv.tile.xy))
-        || any(greaterThan(uv0, sv.tile.xy + sv.tile.zw))) return false;
+    if (!view_project(sv, q, uv0, depth) || !in_tile(sv, uv0)) return false;
     vec2 slope = receiver_slope(sv, q, geo_n, uv0, depth);
     float beyond = depth - SKY_SLAB * g / ortho_depth_scale(view);
     float radius = g * tan(cell);
@@ -111,7 +110,7 @@ bool sky_cone_taps(int view, vec3 p, vec3 n, vec3 geo_n, vec3 d, float g, int k,
         vec4 clip = sv.view_projection * vec4(q + o, 1.0);
         vec2 uv = sv.tile.xy + (clip.xy * 0.5 + 0.5) * sv.tile.zw;
         float seen = 1.0;   // outside the map: nothing blocks it
-        if (all(greaterThanEqual(uv, sv.tile.xy)) && all(lessThanEqual(uv, sv.tile.xy + sv.tile.zw)))
+        if (in_tile(sv, uv))
             seen = texture(u_shadow_atlas, vec3(clamp(uv, lo, hi), min(beyond, depth + dot(slope, uv - uv0))));
         sum += vec4(w, w * seen);
     }
